@@ -1,0 +1,1 @@
+//! Robust identification (IRLS with Nelder-Mead).

@@ -1,0 +1,7 @@
+//! The servo axis: model description and simulation.
+
+pub mod model;
+pub mod sim;
+
+pub use model::{Axis, ControlLaw, Controller, CurrentLoop, Effect, Feedforward, FeedforwardKind, Model};
+pub use sim::{simulate, simulate_batch, Drive, Integrator, SimOptions, SimResult};

@@ -1,0 +1,574 @@
+//! The axis model: mass, force constant, current loop, LuGre friction, extra physics
+//! (the CONTRACT vocabulary of effects) and the controller. Read from the model JSON
+//! of `docs/DESIGN.md`; every field is validated with a message naming its path.
+
+use crate::error::{Error, Result};
+use crate::friction::{LugreParams, StaticSet};
+use serde_json::Value;
+
+/// Current loop between the command and the actual current.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CurrentLoop {
+    /// First-order lag with the given bandwidth [Hz].
+    FirstOrder {
+        /// -3 dB bandwidth [Hz].
+        bandwidth_hz: f64,
+    },
+    /// R-L winding with back-EMF under a continuous PI current controller.
+    Rl {
+        /// Winding resistance [Ohm].
+        resistance: f64,
+        /// Winding inductance [H].
+        inductance: f64,
+        /// Back-EMF constant [V s/m].
+        back_emf: f64,
+        /// Proportional gain [V/A].
+        kp: f64,
+        /// Integral gain [V/(A s)].
+        ki: f64,
+    },
+}
+
+/// The axis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    /// Moving mass [kg].
+    pub mass: f64,
+    /// Force constant K_F [N/A].
+    pub force_constant: f64,
+    /// Optional current loop.
+    pub current_loop: Option<CurrentLoop>,
+    /// Optional current limit [A].
+    pub current_limit: Option<f64>,
+}
+
+/// Physics beyond the LuGre axis (CONTRACT vocabulary).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Effect {
+    /// `F = A*sin(2*pi*x/pitch + phase) + sum_k A_k*sin(k*2*pi*x/pitch + phase_k)`.
+    Cogging {
+        /// Base amplitude [N].
+        amplitude: f64,
+        /// Pitch [m].
+        pitch: f64,
+        /// Phase [rad].
+        phase: f64,
+        /// `(amplitude, phase)` of harmonics 2, 3, ...
+        harmonics: Vec<(f64, f64)>,
+    },
+    /// `F = k*(x - x0)`.
+    Spring {
+        /// Stiffness [N/m].
+        stiffness: f64,
+        /// Rest position [m].
+        x0: f64,
+    },
+    /// Constant force [N].
+    Offset {
+        /// Force [N].
+        force: f64,
+    },
+    /// fc and fs scaled by a piecewise-linear function of position.
+    PositionFriction {
+        /// Breakpoints [m], increasing.
+        positions: Vec<f64>,
+        /// Scale at each breakpoint.
+        scale: Vec<f64>,
+    },
+    /// fc and fs scaled by `1 - gain*(1 - exp(-t/time_constant))`.
+    Drift {
+        /// Relative change at the end of warm-up.
+        gain: f64,
+        /// Time constant [s].
+        time_constant: f64,
+    },
+    /// Extra moving mass [kg].
+    Mass {
+        /// Mass change [kg].
+        delta: f64,
+    },
+    /// The force acts `seconds` after the current command.
+    Delay {
+        /// Dead time [s].
+        seconds: f64,
+    },
+    /// The force follows the current through a first-order lag.
+    CurrentLag {
+        /// Bandwidth [Hz].
+        bandwidth_hz: f64,
+    },
+}
+
+/// Feed-forward law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FeedforwardKind {
+    /// Stribeck curve of the reference velocity.
+    Static,
+    /// LuGre observer driven by the reference velocity.
+    Lugre,
+}
+
+/// Friction feed-forward with its own (identified) friction parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Feedforward {
+    /// Which law.
+    pub kind: FeedforwardKind,
+    /// Friction used for compensation.
+    pub friction: LugreParams<f64>,
+}
+
+/// Control law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ControlLaw {
+    /// PID on position (CONTRACT `pid`, seed paper eq. 12).
+    Pid {
+        /// [N/m]
+        kp: f64,
+        /// [N/(m s)]
+        ki: f64,
+        /// [N s/m]
+        kd: f64,
+    },
+    /// PI on speed.
+    PiSpeed {
+        /// [N s/m]
+        kp: f64,
+        /// [N/m]
+        ki: f64,
+    },
+}
+
+/// Digital controller.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Controller {
+    /// The law.
+    pub law: ControlLaw,
+    /// Update rate [Hz].
+    pub rate_hz: f64,
+    /// Optional friction feed-forward.
+    pub feedforward: Option<Feedforward>,
+}
+
+/// A complete model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// The axis.
+    pub axis: Axis,
+    /// Its friction.
+    pub friction: LugreParams<f64>,
+    /// Extra physics.
+    pub effects: Vec<Effect>,
+    /// Optional controller.
+    pub controller: Option<Controller>,
+}
+
+fn get<'a>(obj: &'a Value, key: &str, path: &str) -> Result<&'a Value> {
+    obj.get(key).ok_or_else(|| {
+        Error::model(
+            &join(path, key),
+            "is missing: add it (see docs/DESIGN.md for the model format)",
+        )
+    })
+}
+
+fn join(path: &str, key: &str) -> String {
+    if path.is_empty() {
+        key.to_string()
+    } else {
+        format!("{path}.{key}")
+    }
+}
+
+fn num(obj: &Value, key: &str, path: &str) -> Result<f64> {
+    let v = get(obj, key, path)?;
+    as_num(v, &join(path, key))
+}
+
+fn as_num(v: &Value, path: &str) -> Result<f64> {
+    let x = v
+        .as_f64()
+        .ok_or_else(|| Error::model(path, format!("must be a number, found {v}")))?;
+    if !x.is_finite() {
+        return Err(Error::parameter(path, x, "must be finite"));
+    }
+    Ok(x)
+}
+
+fn opt_num(obj: &Value, key: &str, path: &str) -> Result<Option<f64>> {
+    match obj.get(key) {
+        None | Some(Value::Null) => Ok(None),
+        Some(v) => as_num(v, &join(path, key)).map(Some),
+    }
+}
+
+fn positive(x: f64, path: &str) -> Result<f64> {
+    if x > 0.0 {
+        Ok(x)
+    } else {
+        Err(Error::parameter(path, x, "must be greater than zero"))
+    }
+}
+
+fn nonneg(x: f64, path: &str) -> Result<f64> {
+    if x >= 0.0 {
+        Ok(x)
+    } else {
+        Err(Error::parameter(path, x, "must be zero or greater"))
+    }
+}
+
+fn num_list(v: &Value, path: &str) -> Result<Vec<f64>> {
+    let a = v
+        .as_array()
+        .ok_or_else(|| Error::model(path, "must be a list of numbers"))?;
+    a.iter()
+        .enumerate()
+        .map(|(k, x)| as_num(x, &format!("{path}[{k}]")))
+        .collect()
+}
+
+/// Parse the `friction` object.
+pub fn parse_friction(f: &Value, path: &str) -> Result<LugreParams<f64>> {
+    if let Some(m) = f.get("model") {
+        if m.as_str() != Some("lugre") {
+            return Err(Error::model(
+                &join(path, "model"),
+                format!("is {m}; only \"lugre\" is supported"),
+            ));
+        }
+    }
+    let set = |dir: &str| -> Result<StaticSet<f64>> {
+        let p = join(path, dir);
+        let s = get(f, dir, path)?;
+        Ok(StaticSet {
+            fc: num(s, "fc", &p)?,
+            fs: num(s, "fs", &p)?,
+            sigma2: num(s, "sigma2", &p)?,
+            vs: num(s, "vs", &p)?,
+        })
+    };
+    let p = LugreParams {
+        sigma0: num(f, "sigma0", path)?,
+        sigma1: num(f, "sigma1", path)?,
+        positive: set("positive")?,
+        negative: set("negative")?,
+    };
+    p.validate().map_err(|e| {
+        let mut err: Error = e.into();
+        if let Error::Parameter { name, .. } = &mut err {
+            if path != "friction" {
+                *name = name.replacen("friction", path, 1);
+            }
+        }
+        err
+    })?;
+    Ok(p)
+}
+
+fn parse_effect(e: &Value, path: &str) -> Result<Effect> {
+    let kind = get(e, "effect", path)?
+        .as_str()
+        .ok_or_else(|| Error::model(&join(path, "effect"), "must be a string"))?;
+    let n = |k: &str| num(e, k, path);
+    let p = |k: &str| join(path, k);
+    Ok(match kind {
+        "cogging" => {
+            let harmonics = match e.get("harmonics") {
+                None | Some(Value::Null) => Vec::new(),
+                Some(h) => {
+                    let hp = p("harmonics");
+                    let a = h.as_array().ok_or_else(|| {
+                        Error::model(&hp, "must be a list of [amplitude, phase] pairs")
+                    })?;
+                    a.iter()
+                        .enumerate()
+                        .map(|(k, pair)| {
+                            let q = num_list(pair, &format!("{hp}[{k}]"))?;
+                            if q.len() != 2 {
+                                return Err(Error::model(
+                                    &format!("{hp}[{k}]"),
+                                    "must be [amplitude, phase]",
+                                ));
+                            }
+                            Ok((q[0], q[1]))
+                        })
+                        .collect::<Result<Vec<_>>>()?
+                }
+            };
+            Effect::Cogging {
+                amplitude: n("amplitude")?,
+                pitch: positive(n("pitch")?, &p("pitch"))?,
+                phase: opt_num(e, "phase", path)?.unwrap_or(0.0),
+                harmonics,
+            }
+        }
+        "spring" => Effect::Spring {
+            stiffness: n("stiffness")?,
+            x0: opt_num(e, "x0", path)?.unwrap_or(0.0),
+        },
+        "offset" => Effect::Offset { force: n("force")? },
+        "position_friction" => {
+            let positions = num_list(get(e, "positions", path)?, &p("positions"))?;
+            let scale = num_list(get(e, "scale", path)?, &p("scale"))?;
+            if positions.is_empty() || positions.len() != scale.len() {
+                return Err(Error::model(
+                    &p("scale"),
+                    format!(
+                        "has {} values for {} positions: give one scale per position",
+                        scale.len(),
+                        positions.len()
+                    ),
+                ));
+            }
+            if let Some(k) = positions.windows(2).position(|w| w[1] <= w[0]) {
+                return Err(Error::model(
+                    &format!("{}[{}]", p("positions"), k + 1),
+                    "positions must be strictly increasing",
+                ));
+            }
+            for (k, &s) in scale.iter().enumerate() {
+                positive(s, &format!("{}[{k}]", p("scale")))?;
+            }
+            Effect::PositionFriction { positions, scale }
+        }
+        "drift" => {
+            let gain = n("gain")?;
+            if gain >= 1.0 {
+                return Err(Error::parameter(
+                    &p("gain"),
+                    gain,
+                    "must be below 1 (friction would vanish or turn negative)",
+                ));
+            }
+            Effect::Drift {
+                gain,
+                time_constant: positive(n("time_constant")?, &p("time_constant"))?,
+            }
+        }
+        "mass" => Effect::Mass { delta: n("delta")? },
+        "delay" => Effect::Delay {
+            seconds: nonneg(n("seconds")?, &p("seconds"))?,
+        },
+        "current_lag" => Effect::CurrentLag {
+            bandwidth_hz: positive(n("bandwidth")?, &p("bandwidth"))?,
+        },
+        other => {
+            return Err(Error::model(
+                &join(path, "effect"),
+                format!(
+                    "unknown effect \"{other}\": use one of cogging, spring, offset, \
+                     position_friction, drift, mass, delay, current_lag"
+                ),
+            ))
+        }
+    })
+}
+
+impl Model {
+    /// Parse and validate a model from its JSON text.
+    pub fn from_json(text: &str) -> Result<Model> {
+        let v: Value = serde_json::from_str(text)
+            .map_err(|e| Error::model("(file)", format!("is not valid JSON: {e}")))?;
+        Model::from_value(&v)
+    }
+
+    /// Parse and validate a model from a JSON value.
+    pub fn from_value(v: &Value) -> Result<Model> {
+        let a = get(v, "axis", "")?;
+        let cl = match a.get("current_loop") {
+            None | Some(Value::Null) => None,
+            Some(c) => {
+                let path = "axis.current_loop";
+                if c.get("inductance").is_some() || c.get("resistance").is_some() {
+                    let r = nonneg(num(c, "resistance", path)?, "axis.current_loop.resistance")?;
+                    let l = positive(num(c, "inductance", path)?, "axis.current_loop.inductance")?;
+                    let ke = nonneg(
+                        opt_num(c, "back_emf", path)?.unwrap_or(0.0),
+                        "axis.current_loop.back_emf",
+                    )?;
+                    let (kp, ki) = match opt_num(c, "bandwidth_hz", path)? {
+                        Some(bw) => {
+                            let bw = positive(bw, "axis.current_loop.bandwidth_hz")?;
+                            let w = 2.0 * core::f64::consts::PI * bw;
+                            (w * l, w * r)
+                        }
+                        None => (
+                            positive(num(c, "kp", path)?, "axis.current_loop.kp")?,
+                            nonneg(num(c, "ki", path)?, "axis.current_loop.ki")?,
+                        ),
+                    };
+                    Some(CurrentLoop::Rl {
+                        resistance: r,
+                        inductance: l,
+                        back_emf: ke,
+                        kp,
+                        ki,
+                    })
+                } else {
+                    Some(CurrentLoop::FirstOrder {
+                        bandwidth_hz: positive(
+                            num(c, "bandwidth_hz", path)?,
+                            "axis.current_loop.bandwidth_hz",
+                        )?,
+                    })
+                }
+            }
+        };
+        let axis = Axis {
+            mass: positive(num(a, "mass", "axis")?, "axis.mass")?,
+            force_constant: positive(num(a, "force_constant", "axis")?, "axis.force_constant")?,
+            current_loop: cl,
+            current_limit: match opt_num(a, "current_limit", "axis")? {
+                None => None,
+                Some(x) => Some(positive(x, "axis.current_limit")?),
+            },
+        };
+        let friction = parse_friction(get(v, "friction", "")?, "friction")?;
+        let effects = match v.get("effects") {
+            None | Some(Value::Null) => Vec::new(),
+            Some(e) => {
+                let list = e
+                    .as_array()
+                    .ok_or_else(|| Error::model("effects", "must be a list"))?;
+                list.iter()
+                    .enumerate()
+                    .map(|(k, x)| parse_effect(x, &format!("effects[{k}]")))
+                    .collect::<Result<Vec<_>>>()?
+            }
+        };
+        let n_delay = effects
+            .iter()
+            .filter(|e| matches!(e, Effect::Delay { .. }))
+            .count();
+        let n_lag = effects
+            .iter()
+            .filter(|e| matches!(e, Effect::CurrentLag { .. }))
+            .count();
+        if n_delay > 1 || n_lag > 1 {
+            return Err(Error::model(
+                "effects",
+                "holds more than one delay or current_lag: merge them into one",
+            ));
+        }
+        let dm: f64 = effects
+            .iter()
+            .map(|e| if let Effect::Mass { delta } = e { *delta } else { 0.0 })
+            .sum();
+        if axis.mass + dm <= 0.0 {
+            return Err(Error::parameter(
+                "effects.mass.delta",
+                dm,
+                "makes the total mass zero or negative",
+            ));
+        }
+        let controller = match v.get("controller") {
+            None | Some(Value::Null) => None,
+            Some(c) => Some(parse_controller(c, &friction)?),
+        };
+        Ok(Model {
+            axis,
+            friction,
+            effects,
+            controller,
+        })
+    }
+
+    /// Total moving mass including `mass` effects.
+    pub fn total_mass(&self) -> f64 {
+        self.axis.mass
+            + self
+                .effects
+                .iter()
+                .map(|e| if let Effect::Mass { delta } = e { *delta } else { 0.0 })
+                .sum::<f64>()
+    }
+}
+
+fn parse_controller(c: &Value, friction: &LugreParams<f64>) -> Result<Controller> {
+    let path = "controller";
+    let kind = get(c, "type", path)?
+        .as_str()
+        .ok_or_else(|| Error::model("controller.type", "must be a string"))?;
+    let law = match kind {
+        "pid" => ControlLaw::Pid {
+            kp: num(c, "kp", path)?,
+            ki: opt_num(c, "ki", path)?.unwrap_or(0.0),
+            kd: opt_num(c, "kd", path)?.unwrap_or(0.0),
+        },
+        "pi_speed" => ControlLaw::PiSpeed {
+            kp: num(c, "kp", path)?,
+            ki: opt_num(c, "ki", path)?.unwrap_or(0.0),
+        },
+        other => {
+            return Err(Error::model(
+                "controller.type",
+                format!("unknown controller \"{other}\": use \"pid\" or \"pi_speed\""),
+            ))
+        }
+    };
+    let rate_hz = positive(num(c, "rate_hz", path)?, "controller.rate_hz")?;
+    let feedforward = match c.get("feedforward") {
+        None | Some(Value::Null) => None,
+        Some(f) => {
+            let kind = match get(f, "type", "controller.feedforward")?.as_str() {
+                Some("static") => FeedforwardKind::Static,
+                Some("lugre") => FeedforwardKind::Lugre,
+                Some("none") => return Ok(Controller { law, rate_hz, feedforward: None }),
+                _ => {
+                    return Err(Error::model(
+                        "controller.feedforward.type",
+                        "must be \"static\", \"lugre\" or \"none\"",
+                    ))
+                }
+            };
+            let friction = match f.get("friction") {
+                None | Some(Value::Null) => *friction,
+                Some(ff) => parse_friction(ff, "controller.feedforward.friction")?,
+            };
+            Some(Feedforward { kind, friction })
+        }
+    };
+    Ok(Controller {
+        law,
+        rate_hz,
+        feedforward,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PAPER: &str = r#"{
+      "axis": {"mass": 25.0, "force_constant": 25.0},
+      "friction": {"model": "lugre", "sigma0": 1e5, "sigma1": 31.62,
+        "positive": {"fc": 28.7, "fs": 60.2, "sigma2": 332.5, "vs": 0.01},
+        "negative": {"fc": 28.5, "fs": 60.1, "sigma2": 333.0, "vs": 0.01}},
+      "effects": [],
+      "controller": {"type": "pid", "kp": 5e4, "ki": 5e5, "kd": 1500, "rate_hz": 10000}
+    }"#;
+
+    #[test]
+    fn parses_contract_example() {
+        let m = Model::from_json(PAPER).unwrap();
+        assert_eq!(m.axis.mass, 25.0);
+        assert_eq!(m.friction.negative.sigma2, 333.0);
+        assert!(matches!(
+            m.controller.unwrap().law,
+            ControlLaw::Pid { kd, .. } if kd == 1500.0
+        ));
+    }
+
+    #[test]
+    fn errors_name_the_path() {
+        let bad = PAPER.replace("\"vs\": 0.01}}", "\"vs\": -0.01}}");
+        let e = Model::from_json(&bad).unwrap_err().to_string();
+        assert!(e.contains("friction.negative.vs"), "{e}");
+        let bad = PAPER.replace("\"mass\": 25.0", "\"mass\": 0");
+        let e = Model::from_json(&bad).unwrap_err().to_string();
+        assert!(e.contains("axis.mass"), "{e}");
+        let bad = PAPER.replace("\"effects\": []", "\"effects\": [{\"effect\": \"magic\"}]");
+        let e = Model::from_json(&bad).unwrap_err().to_string();
+        assert!(e.contains("effects[0].effect") && e.contains("magic"), "{e}");
+    }
+}

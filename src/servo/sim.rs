@@ -1,0 +1,590 @@
+//! Closed- and open-loop simulation of the servo axis with LuGre friction.
+//!
+//! The digital controller runs at `rate_hz` and its output is held between updates
+//! (zero-order hold); the plant is advanced in substeps between events (control
+//! instants and output samples). The default integrator updates the bristle state
+//! exactly with the velocity held and the mechanics by semi-implicit Euler: two `exp()`
+//! per step, no step-size limit from the bristle stiffness. RK4 is there for
+//! comparison. The algorithm is fixed in `docs/DESIGN.md` and mirrored step for step by
+//! `lugre.reference`.
+
+use super::model::{ControlLaw, CurrentLoop, Effect, FeedforwardKind, Model};
+use crate::error::{check_finite, check_len, check_time, Error, Result};
+use crate::friction::{Compensator, LugreParams};
+use std::collections::VecDeque;
+use std::f64::consts::PI;
+
+/// Plant integrator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Integrator {
+    /// Exact bristle update with v held, semi-implicit Euler for x and v.
+    #[default]
+    Exact,
+    /// Classic RK4 on (x, v, z).
+    Rk4,
+}
+
+/// Simulation options.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimOptions {
+    /// Plant integrator.
+    pub integrator: Integrator,
+    /// Plant substeps per control period (or per sample interval in open loop).
+    pub substeps: usize,
+    /// Initial bristle state [m].
+    pub z0: f64,
+    /// Initial position [m]; `None` starts at the reference (or 0).
+    pub x0: Option<f64>,
+    /// Initial velocity [m/s].
+    pub v0: f64,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        Self {
+            integrator: Integrator::Exact,
+            substeps: 1,
+            z0: 0.0,
+            x0: None,
+            v0: 0.0,
+        }
+    }
+}
+
+/// What drives the axis.
+#[derive(Debug, Clone, Copy)]
+pub enum Drive<'a> {
+    /// Position reference for a `pid` controller, sampled at `t`.
+    Position(&'a [f64]),
+    /// Speed reference for a `pi_speed` controller, sampled at `t`.
+    Speed(&'a [f64]),
+    /// Open loop: current command [A] at `t`, held between samples.
+    Current(&'a [f64]),
+}
+
+/// Sampled trajectories.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SimResult {
+    /// Position [m].
+    pub x: Vec<f64>,
+    /// Velocity [m/s].
+    pub v: Vec<f64>,
+    /// Bristle deflection [m].
+    pub z: Vec<f64>,
+    /// Current [A]: actual current with a current loop, else the command.
+    pub i: Vec<f64>,
+    /// LuGre friction force [N].
+    pub friction: Vec<f64>,
+    /// Motor force acting on the mass [N].
+    pub force: Vec<f64>,
+}
+
+/// `np.interp` with a forward-moving cursor (queries must not decrease).
+struct Interp<'a> {
+    t: &'a [f64],
+    y: &'a [f64],
+    j: usize,
+}
+
+impl<'a> Interp<'a> {
+    fn at(&mut self, tq: f64) -> f64 {
+        let n = self.t.len();
+        if tq <= self.t[0] {
+            return self.y[0];
+        }
+        if tq >= self.t[n - 1] {
+            return self.y[n - 1];
+        }
+        while self.j + 1 < n && self.t[self.j + 1] <= tq {
+            self.j += 1;
+        }
+        let (t0, t1) = (self.t[self.j], self.t[self.j + 1]);
+        if tq == t0 {
+            return self.y[self.j];
+        }
+        let y0 = self.y[self.j];
+        y0 + (self.y[self.j + 1] - y0) * (tq - t0) / (t1 - t0)
+    }
+}
+
+/// Extra physics, flattened for the inner loop.
+struct Physics {
+    mass: f64,
+    kf: f64,
+    fr: LugreParams<f64>,
+    lin_a: f64,
+    lin_b: f64,
+    cogging: Vec<(f64, f64, f64)>,
+    pos_scale: Vec<(Vec<f64>, Vec<f64>)>,
+    drift: Vec<(f64, f64)>,
+    has_scale: bool,
+    current_loop: Option<CurrentLoop>,
+    lag_w: Option<f64>,
+    delay: Option<f64>,
+    t0: f64,
+}
+
+fn interp_clamped(xp: &[f64], fp: &[f64], x: f64) -> f64 {
+    let n = xp.len();
+    if x <= xp[0] {
+        return fp[0];
+    }
+    if x >= xp[n - 1] {
+        return fp[n - 1];
+    }
+    // binary search: first index with xp[j] > x
+    let j = xp.partition_point(|&p| p <= x);
+    let (x0, x1) = (xp[j - 1], xp[j]);
+    fp[j - 1] + (fp[j] - fp[j - 1]) * (x - x0) / (x1 - x0)
+}
+
+impl Physics {
+    fn new(m: &Model, t0: f64) -> Self {
+        let mut p = Physics {
+            mass: m.total_mass(),
+            kf: m.axis.force_constant,
+            fr: m.friction,
+            lin_a: 0.0,
+            lin_b: 0.0,
+            cogging: Vec::new(),
+            pos_scale: Vec::new(),
+            drift: Vec::new(),
+            has_scale: false,
+            current_loop: m.axis.current_loop.clone(),
+            lag_w: None,
+            delay: None,
+            t0,
+        };
+        for e in &m.effects {
+            match e {
+                Effect::Cogging {
+                    amplitude,
+                    pitch,
+                    phase,
+                    harmonics,
+                } => {
+                    let w = 2.0 * PI / pitch;
+                    p.cogging.push((*amplitude, w, *phase));
+                    for (k, (a, ph)) in harmonics.iter().enumerate() {
+                        p.cogging.push((*a, w * (k as f64 + 2.0), *ph));
+                    }
+                }
+                Effect::Spring { stiffness, x0 } => {
+                    p.lin_a += stiffness;
+                    p.lin_b -= stiffness * x0;
+                }
+                Effect::Offset { force } => p.lin_b += force,
+                Effect::PositionFriction { positions, scale } => {
+                    p.pos_scale.push((positions.clone(), scale.clone()))
+                }
+                Effect::Drift {
+                    gain,
+                    time_constant,
+                } => p.drift.push((*gain, *time_constant)),
+                Effect::Mass { .. } => {}
+                Effect::Delay { seconds } => p.delay = Some(*seconds),
+                Effect::CurrentLag { bandwidth_hz } => p.lag_w = Some(2.0 * PI * bandwidth_hz),
+            }
+        }
+        p.has_scale = !p.pos_scale.is_empty() || !p.drift.is_empty();
+        p
+    }
+
+    #[inline(always)]
+    fn scale(&self, x: f64, time: f64) -> f64 {
+        if !self.has_scale {
+            return 1.0;
+        }
+        let mut s = 1.0;
+        for (xp, fp) in &self.pos_scale {
+            s *= interp_clamped(xp, fp, x);
+        }
+        for &(gain, tau) in &self.drift {
+            s *= 1.0 - gain * (1.0 - (-(time - self.t0) / tau).exp());
+        }
+        s
+    }
+
+    #[inline(always)]
+    fn effect_force(&self, x: f64) -> f64 {
+        let mut f = self.lin_a * x + self.lin_b;
+        for &(a, w, ph) in &self.cogging {
+            f += a * (w * x + ph).sin();
+        }
+        f
+    }
+
+    #[inline(always)]
+    fn accel(&self, fm: f64, x: f64, v: f64, z: f64, time: f64) -> (f64, f64, f64) {
+        let s = self.scale(x, time);
+        let (g, f, zdot) = self.fr.eval(z, v, s);
+        ((fm - f - self.effect_force(x)) / self.mass, g, zdot)
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+struct State {
+    x: f64,
+    v: f64,
+    z: f64,
+    ia: f64,
+    q: f64,
+    fl: f64,
+}
+
+impl Physics {
+    /// Advance the current (loop) and the lagged force over h; returns the motor force.
+    #[inline(always)]
+    fn motor(&self, s: &mut State, ic: f64, h: f64) -> f64 {
+        match &self.current_loop {
+            None => s.ia = ic,
+            Some(CurrentLoop::FirstOrder { bandwidth_hz }) => {
+                s.ia = ic + (s.ia - ic) * (-2.0 * PI * bandwidth_hz * h).exp();
+            }
+            Some(CurrentLoop::Rl {
+                resistance: r,
+                inductance: l,
+                back_emf: ke,
+                kp,
+                ki,
+            }) => {
+                let wc = kp / l;
+                let ns = ((h * wc * 4.0).ceil() as usize).max(1);
+                let hs = h / ns as f64;
+                let v = s.v;
+                let d = |ia: f64, q: f64| ((kp * (ic - ia) + ki * q - r * ia - ke * v) / l, ic - ia);
+                for _ in 0..ns {
+                    let (a1, b1) = d(s.ia, s.q);
+                    let (a2, b2) = d(s.ia + 0.5 * hs * a1, s.q + 0.5 * hs * b1);
+                    let (a3, b3) = d(s.ia + 0.5 * hs * a2, s.q + 0.5 * hs * b2);
+                    let (a4, b4) = d(s.ia + hs * a3, s.q + hs * b3);
+                    s.ia += hs / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
+                    s.q += hs / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4);
+                }
+            }
+        }
+        let fm = self.kf * s.ia;
+        match self.lag_w {
+            None => fm,
+            Some(w) => {
+                s.fl = fm + (s.fl - fm) * (-w * h).exp();
+                s.fl
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn step_exact(&self, s: &mut State, ic: f64, h: f64, time: f64) {
+        let fm = self.motor(s, ic, h);
+        let (a, g, _) = self.accel(fm, s.x, s.v, s.z, time);
+        s.z = self.fr.advance_z(s.z, s.v, g, h);
+        s.v += a * h;
+        s.x += s.v * h;
+    }
+
+    fn step_rk4(&self, s: &mut State, ic: f64, h: f64, time: f64) {
+        let fm = self.motor(s, ic, h);
+        let d = |x: f64, v: f64, z: f64, tm: f64| {
+            let (a, _, zdot) = self.accel(fm, x, v, z, tm);
+            (v, a, zdot)
+        };
+        let (x, v, z) = (s.x, s.v, s.z);
+        let k1 = d(x, v, z, time);
+        let k2 = d(
+            x + 0.5 * h * k1.0,
+            v + 0.5 * h * k1.1,
+            z + 0.5 * h * k1.2,
+            time + 0.5 * h,
+        );
+        let k3 = d(
+            x + 0.5 * h * k2.0,
+            v + 0.5 * h * k2.1,
+            z + 0.5 * h * k2.2,
+            time + 0.5 * h,
+        );
+        let k4 = d(x + h * k3.0, v + h * k3.1, z + h * k3.2, time + h);
+        s.x += h / 6.0 * (k1.0 + 2.0 * k2.0 + 2.0 * k3.0 + k4.0);
+        s.v += h / 6.0 * (k1.1 + 2.0 * k2.1 + 2.0 * k3.1 + k4.1);
+        s.z += h / 6.0 * (k1.2 + 2.0 * k2.2 + 2.0 * k3.2 + k4.2);
+    }
+}
+
+/// Validate the inputs of [`simulate`].
+pub fn check_inputs(model: &Model, t: &[f64], drive: &Drive, opts: &SimOptions) -> Result<()> {
+    check_time("t", t)?;
+    let (name, a) = match drive {
+        Drive::Position(a) => ("x_ref", a),
+        Drive::Speed(a) => ("v_ref", a),
+        Drive::Current(a) => ("i", a),
+    };
+    check_len(name, a, t.len(), "t")?;
+    check_finite(name, a)?;
+    if opts.substeps == 0 {
+        return Err(Error::parameter(
+            "substeps",
+            0.0,
+            "must be at least 1",
+        ));
+    }
+    for (nm, val) in [("z0", opts.z0), ("v0", opts.v0), ("x0", opts.x0.unwrap_or(0.0))] {
+        if !val.is_finite() {
+            return Err(Error::parameter(nm, val, "must be finite"));
+        }
+    }
+    match drive {
+        Drive::Current(_) => {
+            if t.len() < 2 {
+                return Err(Error::input(
+                    "t",
+                    "open-loop simulation needs at least two samples",
+                ));
+            }
+        }
+        Drive::Position(_) | Drive::Speed(_) => {
+            let c = model.controller.as_ref().ok_or_else(|| {
+                Error::model(
+                    "controller",
+                    "is missing: closed-loop simulation needs a controller (add one, or drive the axis with a current)",
+                )
+            })?;
+            match (c.law, drive) {
+                (ControlLaw::Pid { .. }, Drive::Speed(_)) => {
+                    return Err(Error::input(
+                        "v_ref",
+                        "the model's controller is a position PID: give x_ref instead",
+                    ))
+                }
+                (ControlLaw::PiSpeed { .. }, Drive::Position(_)) => {
+                    return Err(Error::input(
+                        "x_ref",
+                        "the model's controller is a PI speed loop: give v_ref instead",
+                    ))
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Simulate the axis sampled at `t`.
+///
+/// `keep_going` is called every few ten thousand control periods; returning `false`
+/// stops the run with [`Error::Interrupted`].
+///
+/// ```
+/// use lugre::servo::{simulate, Drive, Model, SimOptions};
+/// let m = Model::from_json(r#"{"axis": {"mass": 25, "force_constant": 25},
+///   "friction": {"sigma0": 1e5, "sigma1": 31.62,
+///     "positive": {"fc": 28.7, "fs": 60.2, "sigma2": 332.5, "vs": 0.01},
+///     "negative": {"fc": 28.5, "fs": 60.1, "sigma2": 333.0, "vs": 0.01}},
+///   "controller": {"type": "pid", "kp": 5e4, "ki": 5e5, "kd": 1500, "rate_hz": 10000}}"#).unwrap();
+/// let t: Vec<f64> = (0..10001).map(|k| k as f64 * 1e-4).collect();
+/// let xr: Vec<f64> = t.iter().map(|&s| 0.01 * s).collect();
+/// let r = simulate(&m, &t, Drive::Position(&xr), &SimOptions::default(), &mut || true).unwrap();
+/// assert!((r.x[10000] - 0.01).abs() < 2e-3);
+/// ```
+pub fn simulate(
+    model: &Model,
+    t: &[f64],
+    drive: Drive,
+    opts: &SimOptions,
+    keep_going: &mut dyn FnMut() -> bool,
+) -> Result<SimResult> {
+    check_inputs(model, t, &drive, opts)?;
+    let n_out = t.len();
+    let t0 = t[0];
+    let phys = Physics::new(model, t0);
+    let open_loop = matches!(drive, Drive::Current(_));
+    let (rate, ctrl) = match (&model.controller, open_loop) {
+        (Some(c), false) => (c.rate_hz, Some(c)),
+        _ => (0.0, None),
+    };
+    let h_max = if open_loop {
+        (t[n_out - 1] - t0) / (n_out - 1) as f64 / opts.substeps as f64
+    } else {
+        1.0 / (rate * opts.substeps as f64)
+    };
+    let tol = if open_loop {
+        1e-9 * (t[n_out - 1] - t0) / (n_out - 1) as f64
+    } else {
+        1e-9 / rate
+    };
+    let reference = match drive {
+        Drive::Position(a) | Drive::Speed(a) | Drive::Current(a) => a,
+    };
+    let mut interp = Interp {
+        t,
+        y: reference,
+        j: 0,
+    };
+    let x_init = opts.x0.unwrap_or(match drive {
+        Drive::Position(a) => a[0],
+        _ => 0.0,
+    });
+    let mut s = State {
+        x: x_init,
+        v: opts.v0,
+        z: opts.z0,
+        ia: 0.0,
+        q: 0.0,
+        fl: 0.0,
+    };
+    let mut ff = ctrl.and_then(|c| c.feedforward.as_ref()).map(|f| {
+        (f.kind, f.friction, Compensator::new(f.friction))
+    });
+    let mut out = SimResult {
+        x: Vec::with_capacity(n_out),
+        v: Vec::with_capacity(n_out),
+        z: Vec::with_capacity(n_out),
+        i: Vec::with_capacity(n_out),
+        friction: Vec::with_capacity(n_out),
+        force: Vec::with_capacity(n_out),
+    };
+    let mut queue: VecDeque<(f64, f64)> = VecDeque::new();
+    let mut xi = 0.0;
+    let mut xr_prev = 0.0;
+    let mut ic = 0.0; // latest command
+    let mut ic_eff = 0.0; // command acting on the drive (after delay)
+    let mut time = t0;
+    let mut k = 0usize;
+    let mut n = 0usize;
+    let ctrl_time = |n: usize| -> f64 {
+        if open_loop {
+            if n < n_out {
+                t[n]
+            } else {
+                f64::INFINITY
+            }
+        } else {
+            t0 + n as f64 / rate
+        }
+    };
+    let mut tc = ctrl_time(0);
+    let mut since_check = 0usize;
+    loop {
+        if time >= tc - tol {
+            // controller (or open-loop command) update
+            if let Some(c) = ctrl {
+                let xr = interp.at(tc);
+                let (u, vr) = match c.law {
+                    ControlLaw::Pid { kp, ki, kd } => {
+                        let xr_dot = if n == 0 { 0.0 } else { (xr - xr_prev) * rate };
+                        xr_prev = xr;
+                        let e = xr - s.x;
+                        xi += e / rate;
+                        (kp * e + ki * xi + kd * (xr_dot - s.v), xr_dot)
+                    }
+                    ControlLaw::PiSpeed { kp, ki } => {
+                        let e = xr - s.v;
+                        xi += e / rate;
+                        (kp * e + ki * xi, xr)
+                    }
+                };
+                let f_ff = match &mut ff {
+                    None => 0.0,
+                    Some((FeedforwardKind::Static, p, _)) => p.stribeck(vr),
+                    Some((FeedforwardKind::Lugre, _, comp)) => comp.step(vr, 1.0 / rate),
+                };
+                ic = (u + f_ff) / phys.kf;
+                if let Some(lim) = model.axis.current_limit {
+                    ic = ic.clamp(-lim, lim);
+                }
+            } else {
+                ic = reference[n];
+            }
+            match phys.delay {
+                None => ic_eff = ic,
+                Some(d) => queue.push_back((tc + d, ic)),
+            }
+            n += 1;
+            tc = ctrl_time(n);
+            since_check += 1;
+            if since_check >= 65_536 {
+                since_check = 0;
+                if !keep_going() {
+                    return Err(Error::Interrupted);
+                }
+            }
+        }
+        while k < n_out && t[k] <= time + tol {
+            let sc = phys.scale(s.x, time);
+            let (_, f, _) = phys.fr.eval(s.z, s.v, sc);
+            out.x.push(s.x);
+            out.v.push(s.v);
+            out.z.push(s.z);
+            out.i.push(if phys.current_loop.is_some() { s.ia } else { ic });
+            out.friction.push(f);
+            let fm = phys.kf
+                * if phys.current_loop.is_some() {
+                    s.ia
+                } else if phys.delay.is_some() {
+                    ic_eff_peek(&queue, ic_eff, time, tol)
+                } else {
+                    ic_eff
+                };
+            out.force.push(match phys.lag_w {
+                Some(_) => s.fl,
+                None => fm,
+            });
+            k += 1;
+        }
+        if k == n_out {
+            break;
+        }
+        let next = tc.min(t[k]);
+        let m = (((next - time) / h_max - 1e-6).ceil() as usize).max(1);
+        let h = (next - time) / m as f64;
+        for j in 0..m {
+            let tj = time + j as f64 * h;
+            if phys.delay.is_some() {
+                while let Some(&(te, val)) = queue.front() {
+                    if te <= tj + tol {
+                        ic_eff = val;
+                        queue.pop_front();
+                    } else {
+                        break;
+                    }
+                }
+            }
+            match opts.integrator {
+                Integrator::Exact => phys.step_exact(&mut s, ic_eff, h, tj),
+                Integrator::Rk4 => phys.step_rk4(&mut s, ic_eff, h, tj),
+            }
+        }
+        if !(s.x.is_finite() && s.v.is_finite() && s.z.is_finite()) {
+            return Err(Error::Data(format!(
+                "the simulation diverged at t = {time}: check the controller gains against the mass and the control rate"
+            )));
+        }
+        time = next;
+    }
+    Ok(out)
+}
+
+/// The delayed command that would act at `time` (for reporting the motor force).
+fn ic_eff_peek(queue: &VecDeque<(f64, f64)>, current: f64, time: f64, tol: f64) -> f64 {
+    let mut v = current;
+    for &(te, val) in queue {
+        if te <= time + tol {
+            v = val;
+        } else {
+            break;
+        }
+    }
+    v
+}
+
+/// Simulate many models on the same input in parallel (rayon).
+pub fn simulate_batch(
+    models: &[Model],
+    t: &[f64],
+    drive: Drive,
+    opts: &SimOptions,
+) -> Vec<Result<SimResult>> {
+    use rayon::prelude::*;
+    models
+        .par_iter()
+        .map(|m| simulate(m, t, drive, opts, &mut || true))
+        .collect()
+}
