@@ -15,7 +15,7 @@
 //!
 //! The numerical algorithms are fixed in `docs/DESIGN.md`; the NumPy reference
 //! `lugre.reference` implements the same steps.
-#![cfg_attr(not(feature = "std"), no_std)]
+#![cfg_attr(all(not(feature = "std"), not(test)), no_std)]
 #![warn(missing_docs)]
 
 pub mod friction;

@@ -12,7 +12,7 @@ use num_traits::Float;
 /// use lugre::friction::{Compensator, LugreParams, StaticSet};
 /// let s = StaticSet::<f32>::new(28.7, 60.2, 332.5, 0.01).unwrap();
 /// let mut c = Compensator::new(LugreParams::new(1e5, 31.62, s, s).unwrap());
-/// let mut f = 0.0;
+/// let mut f = 0.0f32;
 /// for _ in 0..10_000 {
 ///     f = c.step(0.05, 1e-4);
 /// }

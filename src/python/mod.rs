@@ -1,0 +1,223 @@
+//! Python bindings (`lugre._core`): convert in, call the core with the interpreter
+//! released, convert out. No numerics here.
+
+use crate::error::{check_finite, Error};
+use crate::friction::{friction_force_into, friction_force_varstep_into};
+use crate::servo::{self, Drive, Integrator, Model, SimOptions, SimResult};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Map a core error onto the package's exception classes (`lugre.exceptions`).
+pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
+    let class = match &e {
+        Error::Parameter { .. } => "ParameterError",
+        Error::Model { .. } => "ModelError",
+        Error::Input { .. } => "InputError",
+        Error::Data(_) => "DataError",
+        Error::Interrupted => return PyKeyboardInterrupt::new_err("interrupted"),
+    };
+    let msg = e.to_string();
+    match py
+        .import("lugre.exceptions")
+        .and_then(|m| m.getattr(class))
+    {
+        Ok(cls) => {
+            let err = match cls.call1((msg.clone(),)) {
+                Ok(inst) => PyErr::from_value(inst),
+                Err(err) => err,
+            };
+            if let Error::Parameter { name, value, .. } = &e {
+                let inst = err.value(py);
+                let _ = inst.setattr("name", name.as_str());
+                let _ = inst.setattr("value", *value);
+            }
+            err
+        }
+        Err(_) => PyValueError::new_err(msg),
+    }
+}
+
+fn slice<'a>(name: &str, a: &'a PyReadonlyArray1<'_, f64>) -> Result<&'a [f64], Error> {
+    a.as_slice()
+        .map_err(|_| Error::input(name, "must be a contiguous 1-D float64 array"))
+}
+
+fn parse_model(py: Python<'_>, text: &str) -> PyResult<Model> {
+    Model::from_json(text).map_err(|e| to_py(py, e))
+}
+
+/// Validate a model given as JSON text; returns whether its friction is passive.
+#[pyfunction]
+fn check_model(py: Python<'_>, model_json: &str) -> PyResult<bool> {
+    Ok(parse_model(py, model_json)?.friction.is_passive())
+}
+
+/// Steady-state (Stribeck) friction force for each velocity.
+#[pyfunction]
+fn stribeck<'py>(
+    py: Python<'py>,
+    v: PyReadonlyArray1<'py, f64>,
+    model_json: &str,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let m = parse_model(py, model_json)?;
+    let v = slice("v", &v).map_err(|e| to_py(py, e))?;
+    check_finite("v", v).map_err(|e| to_py(py, e))?;
+    let out: Vec<f64> = py.detach(|| v.iter().map(|&x| m.friction.stribeck(x)).collect());
+    Ok(out.into_pyarray(py))
+}
+
+/// LuGre force driven by a sampled velocity; returns `(F, z)` (z empty unless asked).
+#[pyfunction]
+#[pyo3(signature = (v, dt, model_json, z0=0.0, return_z=false))]
+fn friction_force<'py>(
+    py: Python<'py>,
+    v: PyReadonlyArray1<'py, f64>,
+    dt: PyReadonlyArray1<'py, f64>,
+    model_json: &str,
+    z0: f64,
+    return_z: bool,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    let m = parse_model(py, model_json)?;
+    let p = m.friction;
+    let vs = slice("v", &v).map_err(|e| to_py(py, e))?;
+    let dts = slice("dt", &dt).map_err(|e| to_py(py, e))?;
+    let (f, z) = py.detach(|| {
+        let mut f = vec![0.0; vs.len()];
+        let mut z = if return_z { vec![0.0; vs.len()] } else { Vec::new() };
+        let zo = if return_z { Some(&mut z[..]) } else { None };
+        if dts.len() == 1 {
+            friction_force_into(&p, vs, dts[0], z0, &mut f, zo);
+        } else {
+            friction_force_varstep_into(&p, vs, dts, z0, &mut f, zo);
+        }
+        (f, z)
+    });
+    Ok((f.into_pyarray(py), z.into_pyarray(py)))
+}
+
+fn parse_opts(integrator: &str, substeps: usize, z0: f64, x0: Option<f64>, v0: f64) -> Result<SimOptions, Error> {
+    let integrator = match integrator {
+        "exact" => Integrator::Exact,
+        "rk4" => Integrator::Rk4,
+        other => {
+            return Err(Error::input(
+                "integrator",
+                format!("unknown integrator \"{other}\": use \"exact\" or \"rk4\""),
+            ))
+        }
+    };
+    Ok(SimOptions {
+        integrator,
+        substeps,
+        z0,
+        x0,
+        v0,
+    })
+}
+
+fn drive_of<'a>(kind: &str, a: &'a [f64]) -> Result<Drive<'a>, Error> {
+    Ok(match kind {
+        "x_ref" => Drive::Position(a),
+        "v_ref" => Drive::Speed(a),
+        "current" => Drive::Current(a),
+        other => return Err(Error::input("drive", format!("unknown drive \"{other}\""))),
+    })
+}
+
+fn result_dict<'py>(py: Python<'py>, r: SimResult) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("x", r.x.into_pyarray(py))?;
+    d.set_item("v", r.v.into_pyarray(py))?;
+    d.set_item("z", r.z.into_pyarray(py))?;
+    d.set_item("i", r.i.into_pyarray(py))?;
+    d.set_item("friction", r.friction.into_pyarray(py))?;
+    d.set_item("force", r.force.into_pyarray(py))?;
+    Ok(d)
+}
+
+/// Simulate the axis; returns a dict of arrays (x, v, z, i, friction, force).
+///
+/// Runs with the interpreter released and checks for Ctrl-C every 65,536 control
+/// periods.
+#[pyfunction]
+#[pyo3(signature = (model_json, t, drive_kind, drive, integrator="exact", substeps=1, z0=0.0, x0=None, v0=0.0))]
+#[allow(clippy::too_many_arguments)]
+fn simulate<'py>(
+    py: Python<'py>,
+    model_json: &str,
+    t: PyReadonlyArray1<'py, f64>,
+    drive_kind: &str,
+    drive: PyReadonlyArray1<'py, f64>,
+    integrator: &str,
+    substeps: usize,
+    z0: f64,
+    x0: Option<f64>,
+    v0: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = parse_model(py, model_json)?;
+    let run = || -> Result<SimResult, Error> {
+        let opts = parse_opts(integrator, substeps, z0, x0, v0)?;
+        let ts = slice("t", &t)?;
+        let d = drive_of(drive_kind, slice(drive_kind, &drive)?)?;
+        py.detach(|| {
+            servo::simulate(&m, ts, d, &opts, &mut || {
+                Python::attach(|py| py.check_signals().is_ok())
+            })
+        })
+    };
+    let r = run().map_err(|e| to_py(py, e))?;
+    result_dict(py, r)
+}
+
+/// Simulate many models on the same input in parallel; returns a list of dicts.
+#[pyfunction]
+#[pyo3(signature = (model_jsons, t, drive_kind, drive, integrator="exact", substeps=1, z0=0.0, x0=None, v0=0.0))]
+#[allow(clippy::too_many_arguments)]
+fn simulate_batch<'py>(
+    py: Python<'py>,
+    model_jsons: Vec<String>,
+    t: PyReadonlyArray1<'py, f64>,
+    drive_kind: &str,
+    drive: PyReadonlyArray1<'py, f64>,
+    integrator: &str,
+    substeps: usize,
+    z0: f64,
+    x0: Option<f64>,
+    v0: f64,
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let models = model_jsons
+        .iter()
+        .map(|s| parse_model(py, s))
+        .collect::<PyResult<Vec<_>>>()?;
+    let results = (|| -> Result<Vec<SimResult>, Error> {
+        let opts = parse_opts(integrator, substeps, z0, x0, v0)?;
+        let ts = slice("t", &t)?;
+        let d = drive_of(drive_kind, slice(drive_kind, &drive)?)?;
+        py.detach(|| servo::simulate_batch(&models, ts, d, &opts))
+            .into_iter()
+            .collect()
+    })()
+    .map_err(|e| to_py(py, e))?;
+    results.into_iter().map(|r| result_dict(py, r)).collect()
+}
+
+/// Number of worker threads used by batch functions.
+#[pyfunction]
+fn num_threads() -> usize {
+    rayon::current_num_threads()
+}
+
+/// The compiled core of `lugre`.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(check_model, m)?)?;
+    m.add_function(wrap_pyfunction!(stribeck, m)?)?;
+    m.add_function(wrap_pyfunction!(friction_force, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(num_threads, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
