@@ -1,0 +1,119 @@
+"""The result of a simulation, shared by :mod:`lugre` (Rust core) and :mod:`lugre.reference`."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+__all__ = ["SimResult"]
+
+
+class SimResult:
+    """Sampled trajectories of a simulated axis, one value per sample time.
+
+    Parameters
+    ----------
+    t : array_like
+        Sample times [s].
+    x : array_like
+        Position [m].
+    v : array_like
+        Velocity [m/s].
+    z : array_like
+        Bristle deflection [m].
+    i : array_like
+        Current [A]: the actual current with a current loop, else the command.
+    friction : array_like
+        LuGre friction force [N].
+    force : array_like
+        Motor force acting on the mass [N].
+
+    Attributes
+    ----------
+    t, x, v, z, i, friction, force : numpy.ndarray
+        1-D float64 arrays of equal length.
+    """
+
+    __slots__ = ("force", "friction", "i", "t", "v", "x", "z")
+
+    #: Names of the arrays, in order.
+    fields: tuple[str, ...] = ("t", "x", "v", "z", "i", "friction", "force")
+
+    t: np.ndarray
+    x: np.ndarray
+    v: np.ndarray
+    z: np.ndarray
+    i: np.ndarray
+    friction: np.ndarray
+    force: np.ndarray
+
+    def __init__(
+        self,
+        t: Any,
+        x: Any,
+        v: Any,
+        z: Any,
+        i: Any,
+        friction: Any,
+        force: Any,
+    ) -> None:
+        arrays = {"t": t, "x": x, "v": v, "z": z, "i": i, "friction": friction,
+                  "force": force}
+        n = None
+        for name, a in arrays.items():
+            arr = np.ascontiguousarray(a, dtype=np.float64)
+            if arr.ndim != 1:
+                raise ValueError(f"SimResult.{name} must be 1-D, got shape {arr.shape}")
+            if n is None:
+                n = arr.size
+            elif arr.size != n:
+                raise ValueError(
+                    f"SimResult.{name} has {arr.size} samples but t has {n}"
+                )
+            object.__setattr__(self, name, arr)
+
+    @classmethod
+    def from_dict(cls, t: Any, arrays: Mapping[str, Any]) -> SimResult:
+        """Build from the sample times and a mapping with the other six arrays.
+
+        Parameters
+        ----------
+        t : array_like
+            Sample times [s].
+        arrays : Mapping
+            ``x``, ``v``, ``z``, ``i``, ``friction`` and ``force``.
+
+        Returns
+        -------
+        SimResult
+        """
+        return cls(t, *(arrays[k] for k in cls.fields[1:]))
+
+    def to_dict(self) -> dict[str, np.ndarray]:
+        """The arrays by name (not copies).
+
+        Returns
+        -------
+        dict
+        """
+        return {k: getattr(self, k) for k in self.fields}
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    def __repr__(self) -> str:
+        n = self.t.size
+        span = f", t=[{self.t[0]:g}, {self.t[-1]:g}] s" if n else ""
+        return f"SimResult({n} samples{span}; fields {', '.join(self.fields)})"
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, SimResult):
+            return NotImplemented
+        return all(np.array_equal(getattr(self, k), getattr(other, k)) for k in self.fields)
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (SimResult, tuple(getattr(self, k) for k in self.fields))

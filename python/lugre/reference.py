@@ -1,0 +1,651 @@
+"""The NumPy reference: the algorithms of ``docs/DESIGN.md`` in plain Python.
+
+Same names, signatures and results as the Rust-backed :mod:`lugre` API, written with
+NumPy alone (no SciPy) as loops over Python floats that repeat the core's
+(``src/friction/mod.rs``, ``src/servo/sim.rs``) operations in the same order, so that
+the two agree to rounding (about 1e-12). It is slow (a few microseconds per plant step)
+and meant for checking the core and for reading.
+
+Examples
+--------
+>>> from lugre import reference
+>>> from lugre.model import Model
+>>> m = Model.paper()
+>>> float(reference.stribeck([0.01], m)[0])  # doctest: +ELLIPSIS
+43.613...
+"""
+
+from __future__ import annotations
+
+import math
+from bisect import bisect_right
+from collections import deque
+from numbers import Integral
+from typing import Any, Callable
+
+import numpy as np
+
+from ._result import SimResult
+from .exceptions import DataError, InputError, ModelError, ParameterError
+from .model import ModelLike, _as_model, _CurrentLoop, _Friction, _Parsed, _StaticSet
+
+__all__ = ["SimResult", "friction_force", "simulate", "stribeck"]
+
+_PI = math.pi
+_exp = math.exp
+
+
+# --------------------------------------------------------------------------------------
+# Input checks (src/error.rs), raising the same information as the core
+# --------------------------------------------------------------------------------------
+
+
+def _array(name: str, a: Any) -> np.ndarray:
+    """``np.asarray(a, float)`` as a 1-D array, or InputError naming the argument."""
+    try:
+        arr = np.asarray(a, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise InputError.at(name, f"must be an array of numbers ({e})") from None
+    if arr.ndim != 1:
+        raise InputError.at(name, f"must be a 1-D array, got shape {arr.shape}")
+    return arr
+
+
+def _check_finite(name: str, a: list[float]) -> None:
+    for k, x in enumerate(a):
+        if not math.isfinite(x):
+            raise InputError.at(
+                name, f"element {k} is {x} : remove or interpolate non-finite samples"
+            )
+
+
+def _check_time(name: str, t: list[float]) -> None:
+    if not t:
+        raise InputError.at(name, "is empty: give at least one sample")
+    _check_finite(name, t)
+    for k in range(len(t) - 1):
+        if t[k + 1] <= t[k]:
+            raise InputError.at(
+                name,
+                f"time is not strictly increasing at element {k + 1} ({t[k + 1]} after "
+                f"{t[k]}): sort the record and drop repeated samples",
+            )
+
+
+def _check_len(name: str, a: list[float], n: int, of: str) -> None:
+    if len(a) != n:
+        raise InputError.at(
+            name, f"has {len(a)} samples but {of} has {n}: give arrays of the same length"
+        )
+
+
+def _finite_option(name: str, value: Any) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError.invalid(name, value, "must be a finite number") from None
+    if not math.isfinite(x):
+        raise ParameterError.invalid(name, x, "must be finite")
+    return x
+
+
+# --------------------------------------------------------------------------------------
+# Friction (src/friction/mod.rs)
+# --------------------------------------------------------------------------------------
+
+
+def _g(s: _StaticSet, v: float) -> float:
+    """``g(v) = fc + (fs - fc)*exp(-(v/vs)^2)``."""
+    r = v / s.vs
+    return s.fc + (s.fs - s.fc) * _exp(-(r * r))
+
+
+def _stribeck1(p: _Friction, v: float) -> float:
+    """Steady-state friction ``sign(v)*g(v) + sigma2*v``, zero at ``v == 0``."""
+    if v == 0.0:
+        return 0.0
+    s = p.positive if v >= 0.0 else p.negative
+    return (1.0 if v > 0.0 else -1.0) * _g(s, v) + s.sigma2 * v
+
+
+def _eval(p: _Friction, z: float, v: float, scale: float) -> tuple[float, float, float]:
+    """``(g, F, zdot)`` at state ``z`` and velocity ``v`` (``LugreParams::eval``)."""
+    s = p.positive if v >= 0.0 else p.negative
+    g = scale * _g(s, v)
+    zdot = v - p.sigma0 * abs(v) * z / g
+    f = p.sigma0 * z + p.sigma1 * zdot + s.sigma2 * v
+    return g, f, zdot
+
+
+def _advance_z(p: _Friction, z: float, v: float, g: float, h: float) -> float:
+    """Exact bristle update over ``h`` with ``v`` held (``LugreParams::advance_z``)."""
+    if v == 0.0:
+        return z
+    zss = (1.0 if v > 0.0 else -1.0) * g / p.sigma0
+    return zss + (z - zss) * _exp(-(p.sigma0 * abs(v) * h / g))
+
+
+class _Compensator:
+    """LuGre observer (``friction::Compensator``)."""
+
+    def __init__(self, p: _Friction) -> None:
+        self.p = p
+        self.z = 0.0
+
+    def step(self, v: float, dt: float) -> float:
+        if not math.isfinite(v) or not math.isfinite(dt) or dt < 0.0:
+            return self.p.sigma0 * self.z
+        g, f, _ = _eval(self.p, self.z, v, 1.0)
+        self.z = _advance_z(self.p, self.z, v, g, dt)
+        return f
+
+
+def stribeck(v: Any, model: ModelLike) -> np.ndarray:
+    """Steady-state (Stribeck) friction force for each velocity.
+
+    ``F_ss(v) = sign(v)*g(v) + sigma2*v`` with the ``positive`` set for ``v >= 0`` and
+    the ``negative`` set for ``v < 0``, and ``F_ss(0) = 0``.
+
+    Parameters
+    ----------
+    v : array_like
+        Velocities [m/s], 1-D.
+    model : Model, dict or path
+        The model (only its friction is used).
+
+    Returns
+    -------
+    numpy.ndarray
+        Forces [N], float64, same length as ``v``.
+
+    Raises
+    ------
+    InputError
+        ``v`` is not 1-D or holds NaN or inf.
+    """
+    p = _as_model(model)._parsed.friction
+    vv = _array("v", v).tolist()
+    _check_finite("v", vv)
+    return np.array([_stribeck1(p, x) for x in vv], dtype=np.float64)
+
+
+def friction_force(
+    v: Any,
+    dt: Any,
+    model: ModelLike,
+    *,
+    z0: float = 0.0,
+    return_z: bool = False,
+) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """LuGre friction force driven by a sampled velocity signal.
+
+    For ``k = 0 .. n-1``: ``F[k]`` is the force at state ``z`` and ``v[k]``; then ``z``
+    advances exactly over ``dt`` (or ``dt[k]``) with ``v[k]`` held.
+
+    Parameters
+    ----------
+    v : array_like
+        Velocities [m/s], 1-D.
+    dt : float or array_like
+        Hold interval [s]: one value, or one per sample (``dt[k]`` follows ``v[k]``).
+    model : Model, dict or path
+        The model (only its friction is used).
+    z0 : float, default 0.0
+        Initial bristle deflection [m].
+    return_z : bool, default False
+        Also return ``z[k]``, the state at which ``F[k]`` was evaluated.
+
+    Returns
+    -------
+    F : numpy.ndarray
+        Friction force [N].
+    z : numpy.ndarray
+        Only with ``return_z``.
+
+    Raises
+    ------
+    InputError
+        ``v`` or ``dt`` not finite, ``dt`` negative or of the wrong length.
+    ParameterError
+        ``z0`` not finite.
+    """
+    p = _as_model(model)._parsed.friction
+    vv = _array("v", v).tolist()
+    _check_finite("v", vv)
+    dta = np.asarray(dt, dtype=float)
+    if dta.ndim == 0 or dta.size == 1:
+        dts = [float(dta.reshape(-1)[0])] if dta.size else []
+        scalar = True
+    else:
+        dts = _array("dt", dta).tolist()
+        _check_len("dt", dts, len(vv), "v")
+        scalar = False
+    if dta.size == 0:
+        raise InputError.at("dt", "is empty: give the hold interval [s]")
+    _check_finite("dt", dts)
+    for k, h in enumerate(dts):
+        if h < 0.0:
+            raise InputError.at("dt", f"element {k} is {h}: hold intervals must be >= 0")
+    z = _finite_option("z0", z0)
+    n = len(vv)
+    out = [0.0] * n
+    zs = [0.0] * n
+    h = dts[0]
+    for k in range(n):
+        vk = vv[k]
+        g, f, _ = _eval(p, z, vk, 1.0)
+        out[k] = f
+        zs[k] = z
+        z = _advance_z(p, z, vk, g, h if scalar else dts[k])
+    F = np.array(out, dtype=np.float64)
+    if return_z:
+        return F, np.array(zs, dtype=np.float64)
+    return F
+
+
+# --------------------------------------------------------------------------------------
+# Servo simulation (src/servo/sim.rs)
+# --------------------------------------------------------------------------------------
+
+
+class _Interp:
+    """``np.interp`` with a forward-moving cursor (queries must not decrease)."""
+
+    def __init__(self, t: list[float], y: list[float]) -> None:
+        self.t, self.y, self.j, self.n = t, y, 0, len(t)
+
+    def at(self, tq: float) -> float:
+        t, y, n = self.t, self.y, self.n
+        if tq <= t[0]:
+            return y[0]
+        if tq >= t[n - 1]:
+            return y[n - 1]
+        while self.j + 1 < n and t[self.j + 1] <= tq:
+            self.j += 1
+        j = self.j
+        t0, t1 = t[j], t[j + 1]
+        if tq == t0:
+            return y[j]
+        y0 = y[j]
+        return y0 + (y[j + 1] - y0) * (tq - t0) / (t1 - t0)
+
+
+def _interp_clamped(xp: tuple[float, ...], fp: tuple[float, ...], x: float) -> float:
+    n = len(xp)
+    if x <= xp[0]:
+        return fp[0]
+    if x >= xp[n - 1]:
+        return fp[n - 1]
+    j = bisect_right(xp, x)  # first index with xp[j] > x
+    x0, x1 = xp[j - 1], xp[j]
+    return fp[j - 1] + (fp[j] - fp[j - 1]) * (x - x0) / (x1 - x0)
+
+
+class _State:
+    __slots__ = ("fl", "ia", "q", "v", "x", "z")
+
+    def __init__(self, x: float, v: float, z: float) -> None:
+        self.x, self.v, self.z = x, v, z
+        self.ia = self.q = self.fl = 0.0
+
+
+class _Physics:
+    """Extra physics flattened for the inner loop (``Physics`` in sim.rs)."""
+
+    def __init__(self, m: _Parsed, t0: float) -> None:
+        self.mass = m.total_mass
+        self.kf = m.axis.force_constant
+        self.fr = m.friction
+        self.lin_a = 0.0
+        self.lin_b = 0.0
+        self.cogging: list[tuple[float, float, float]] = []
+        self.pos_scale: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
+        self.drift: list[tuple[float, float]] = []
+        self.current_loop: _CurrentLoop | None = m.axis.current_loop
+        self.lag_w: float | None = None
+        self.delay: float | None = None
+        self.t0 = t0
+        for e in m.effects:
+            q = e.params
+            if e.kind == "cogging":
+                w = 2.0 * _PI / q["pitch"]
+                self.cogging.append((q["amplitude"], w, q["phase"]))
+                for k, (a, ph) in enumerate(q["harmonics"]):
+                    self.cogging.append((a, w * (k + 2.0), ph))
+            elif e.kind == "spring":
+                self.lin_a += q["stiffness"]
+                self.lin_b -= q["stiffness"] * q["x0"]
+            elif e.kind == "offset":
+                self.lin_b += q["force"]
+            elif e.kind == "position_friction":
+                self.pos_scale.append((q["positions"], q["scale"]))
+            elif e.kind == "drift":
+                self.drift.append((q["gain"], q["time_constant"]))
+            elif e.kind == "delay":
+                self.delay = q["seconds"]
+            elif e.kind == "current_lag":
+                self.lag_w = 2.0 * _PI * q["bandwidth_hz"]
+        self.has_scale = bool(self.pos_scale) or bool(self.drift)
+
+    def scale(self, x: float, time: float) -> float:
+        if not self.has_scale:
+            return 1.0
+        s = 1.0
+        for xp, fp in self.pos_scale:
+            s *= _interp_clamped(xp, fp, x)
+        for gain, tau in self.drift:
+            s *= 1.0 - gain * (1.0 - _exp(-(time - self.t0) / tau))
+        return s
+
+    def effect_force(self, x: float) -> float:
+        f = self.lin_a * x + self.lin_b
+        for a, w, ph in self.cogging:
+            f += a * math.sin(w * x + ph)
+        return f
+
+    def accel(
+        self, fm: float, x: float, v: float, z: float, time: float
+    ) -> tuple[float, float, float]:
+        s = self.scale(x, time)
+        g, f, zdot = _eval(self.fr, z, v, s)
+        return (fm - f - self.effect_force(x)) / self.mass, g, zdot
+
+    def motor(self, s: _State, ic: float, h: float) -> float:
+        """Advance the current (loop) and the lagged force over ``h``; the motor force."""
+        cl = self.current_loop
+        if cl is None:
+            s.ia = ic
+        elif cl.kind == "first_order":
+            s.ia = ic + (s.ia - ic) * _exp(-2.0 * _PI * cl.bandwidth_hz * h)
+        else:
+            r, ind, ke, kp, ki = cl.resistance, cl.inductance, cl.back_emf, cl.kp, cl.ki
+            wc = kp / ind
+            ns = max(math.ceil(h * wc * 4.0), 1)
+            hs = h / ns
+            v = s.v
+
+            def d(ia: float, q: float) -> tuple[float, float]:
+                return (kp * (ic - ia) + ki * q - r * ia - ke * v) / ind, ic - ia
+
+            for _ in range(ns):
+                a1, b1 = d(s.ia, s.q)
+                a2, b2 = d(s.ia + 0.5 * hs * a1, s.q + 0.5 * hs * b1)
+                a3, b3 = d(s.ia + 0.5 * hs * a2, s.q + 0.5 * hs * b2)
+                a4, b4 = d(s.ia + hs * a3, s.q + hs * b3)
+                s.ia += hs / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+                s.q += hs / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4)
+        fm = self.kf * s.ia
+        if self.lag_w is None:
+            return fm
+        s.fl = fm + (s.fl - fm) * _exp(-self.lag_w * h)
+        return s.fl
+
+    def step_exact(self, s: _State, ic: float, h: float, time: float) -> None:
+        fm = self.motor(s, ic, h)
+        a, g, _ = self.accel(fm, s.x, s.v, s.z, time)
+        s.z = _advance_z(self.fr, s.z, s.v, g, h)
+        s.v += a * h
+        s.x += s.v * h
+
+    def step_rk4(self, s: _State, ic: float, h: float, time: float) -> None:
+        fm = self.motor(s, ic, h)
+
+        def d(x: float, v: float, z: float, tm: float) -> tuple[float, float, float]:
+            a, _, zdot = self.accel(fm, x, v, z, tm)
+            return v, a, zdot
+
+        x, v, z = s.x, s.v, s.z
+        k1 = d(x, v, z, time)
+        k2 = d(x + 0.5 * h * k1[0], v + 0.5 * h * k1[1], z + 0.5 * h * k1[2], time + 0.5 * h)
+        k3 = d(x + 0.5 * h * k2[0], v + 0.5 * h * k2[1], z + 0.5 * h * k2[2], time + 0.5 * h)
+        k4 = d(x + h * k3[0], v + h * k3[1], z + h * k3[2], time + h)
+        s.x += h / 6.0 * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0])
+        s.v += h / 6.0 * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1])
+        s.z += h / 6.0 * (k1[2] + 2.0 * k2[2] + 2.0 * k3[2] + k4[2])
+
+
+def _ic_eff_peek(queue: deque[tuple[float, float]], current: float, time: float,
+                 tol: float) -> float:
+    """The delayed command that would act at ``time`` (for reporting the motor force)."""
+    v = current
+    for te, val in queue:
+        if te <= time + tol:
+            v = val
+        else:
+            break
+    return v
+
+
+def simulate(
+    model: ModelLike,
+    t: Any,
+    x_ref: Any = None,
+    *,
+    v_ref: Any = None,
+    current: Any = None,
+    integrator: str = "exact",
+    substeps: int = 1,
+    z0: float = 0.0,
+    x0: float | None = None,
+    v0: float = 0.0,
+) -> SimResult:
+    """Simulate the axis under its controller (or in open loop), sampled at ``t``.
+
+    The digital controller runs at ``controller.rate_hz`` with its output held between
+    updates; the plant is advanced in substeps between events (control instants and
+    sample times), as fixed in ``docs/DESIGN.md``.
+
+    Parameters
+    ----------
+    model : Model, dict or path
+        The axis model. Closed loop needs its ``controller``.
+    t : array_like
+        Sample times [s], strictly increasing; the simulation starts at ``t[0]``.
+    x_ref : array_like, optional
+        Position reference [m] at ``t`` for a ``pid`` controller.
+    v_ref : array_like, optional
+        Speed reference [m/s] at ``t`` for a ``pi_speed`` controller.
+    current : array_like, optional
+        Open loop: current command [A] at ``t``, held between samples (the controller
+        is not used). Give exactly one of ``x_ref``, ``v_ref`` and ``current``.
+    integrator : {"exact", "rk4"}, default "exact"
+        ``"exact"``: exact bristle update with the velocity held and semi-implicit Euler
+        for x and v; ``"rk4"``: classic RK4 on (x, v, z).
+    substeps : int, default 1
+        Plant steps per control period (per sample interval in open loop).
+    z0 : float, default 0.0
+        Initial bristle deflection [m].
+    x0 : float, optional
+        Initial position [m]; by default ``x_ref[0]`` (0 without a position reference).
+    v0 : float, default 0.0
+        Initial velocity [m/s].
+
+    Returns
+    -------
+    SimResult
+        ``t``, ``x``, ``v``, ``z``, ``i``, ``friction`` and ``force`` at the sample times.
+
+    Raises
+    ------
+    InputError
+        ``t`` empty, not finite or not strictly increasing; the drive of another length
+        or not finite; the wrong drive for the controller; unknown integrator.
+    ParameterError
+        ``substeps`` below 1; ``z0``, ``x0`` or ``v0`` not finite.
+    ModelError
+        Closed loop without a controller.
+    DataError
+        The simulation diverged.
+    """
+    m = _as_model(model)._parsed
+    if integrator not in ("exact", "rk4"):
+        raise InputError.at(
+            "integrator", f'unknown integrator "{integrator}": use "exact" or "rk4"'
+        )
+    if isinstance(substeps, bool) or not isinstance(substeps, Integral):
+        raise TypeError(f"substeps must be an integer, got {type(substeps).__name__}")
+    drives = [(k, a) for k, a in (("x_ref", x_ref), ("v_ref", v_ref), ("current", current))
+              if a is not None]
+    if not drives:
+        raise InputError.at(
+            "x_ref",
+            "nothing drives the axis: give a position reference x_ref, a speed reference "
+            "v_ref, or an open-loop current",
+        )
+    if len(drives) > 1:
+        raise InputError.at(
+            drives[1][0],
+            f"give only one of x_ref, v_ref and current (got {drives[0][0]} and "
+            f"{drives[1][0]})",
+        )
+    kind, drive_in = drives[0]
+    ta = _array("t", t)
+    tl = ta.tolist()
+    ref = _array(kind, drive_in).tolist()
+    open_loop = kind == "current"
+
+    # ---- check_inputs ---------------------------------------------------------------
+    _check_time("t", tl)
+    name = {"x_ref": "x_ref", "v_ref": "v_ref", "current": "i"}[kind]
+    _check_len(name, ref, len(tl), "t")
+    _check_finite(name, ref)
+    if int(substeps) < 1:
+        raise ParameterError.invalid("substeps", float(substeps), "must be at least 1")
+    substeps = int(substeps)
+    z_init = _finite_option("z0", z0)
+    v_init = _finite_option("v0", v0)
+    x_opt = None if x0 is None else _finite_option("x0", x0)
+    if open_loop:
+        if len(tl) < 2:
+            raise InputError.at("t", "open-loop simulation needs at least two samples")
+    else:
+        c = m.controller
+        if c is None:
+            raise ModelError.at(
+                "controller",
+                "is missing: closed-loop simulation needs a controller (add one, or "
+                "drive the axis with a current)",
+            )
+        if c.law == "pid" and kind == "v_ref":
+            raise InputError.at(
+                "v_ref", "the model's controller is a position PID: give x_ref instead"
+            )
+        if c.law == "pi_speed" and kind == "x_ref":
+            raise InputError.at(
+                "x_ref", "the model's controller is a PI speed loop: give v_ref instead"
+            )
+
+    # ---- simulate -------------------------------------------------------------------
+    n_out = len(tl)
+    t0 = tl[0]
+    phys = _Physics(m, t0)
+    ctrl = None if open_loop else m.controller
+    rate = ctrl.rate_hz if ctrl is not None else 0.0
+    if open_loop:
+        h_max = (tl[n_out - 1] - t0) / (n_out - 1) / substeps
+        tol = 1e-9 * (tl[n_out - 1] - t0) / (n_out - 1)
+    else:
+        h_max = 1.0 / (rate * substeps)
+        tol = 1e-9 / rate
+    interp = _Interp(tl, ref)
+    x_init = x_opt if x_opt is not None else (ref[0] if kind == "x_ref" else 0.0)
+    s = _State(x_init, v_init, z_init)
+    comp = (
+        _Compensator(ctrl.ff_friction)
+        if ctrl is not None and ctrl.ff_kind == "lugre" and ctrl.ff_friction is not None
+        else None
+    )
+    step: Callable[[_State, float, float, float], None] = (
+        phys.step_exact if integrator == "exact" else phys.step_rk4
+    )
+    lim = m.axis.current_limit
+    out_x: list[float] = []
+    out_v: list[float] = []
+    out_z: list[float] = []
+    out_i: list[float] = []
+    out_f: list[float] = []
+    out_fm: list[float] = []
+    queue: deque[tuple[float, float]] = deque()
+    xi = 0.0
+    xr_prev = 0.0
+    ic = 0.0  # latest command
+    ic_eff = 0.0  # command acting on the drive (after delay)
+    time = t0
+    k = 0
+    n = 0
+
+    def ctrl_time(n: int) -> float:
+        if open_loop:
+            return tl[n] if n < n_out else math.inf
+        return t0 + n / rate
+
+    tc = ctrl_time(0)
+    while True:
+        if time >= tc - tol:
+            # controller (or open-loop command) update
+            if ctrl is not None:
+                xr = interp.at(tc)
+                if ctrl.law == "pid":
+                    xr_dot = 0.0 if n == 0 else (xr - xr_prev) * rate
+                    xr_prev = xr
+                    e = xr - s.x
+                    xi += e / rate
+                    u = ctrl.kp * e + ctrl.ki * xi + ctrl.kd * (xr_dot - s.v)
+                    vr = xr_dot
+                else:
+                    e = xr - s.v
+                    xi += e / rate
+                    u = ctrl.kp * e + ctrl.ki * xi
+                    vr = xr
+                if ctrl.ff_kind is None or ctrl.ff_friction is None:
+                    f_ff = 0.0
+                elif ctrl.ff_kind == "static":
+                    f_ff = _stribeck1(ctrl.ff_friction, vr)
+                else:
+                    assert comp is not None
+                    f_ff = comp.step(vr, 1.0 / rate)
+                ic = (u + f_ff) / phys.kf
+                if lim is not None:
+                    ic = max(min(ic, lim), -lim)  # f64::clamp
+            else:
+                ic = ref[n]
+            if phys.delay is None:
+                ic_eff = ic
+            else:
+                queue.append((tc + phys.delay, ic))
+            n += 1
+            tc = ctrl_time(n)
+        while k < n_out and tl[k] <= time + tol:
+            sc = phys.scale(s.x, time)
+            _, f, _ = _eval(phys.fr, s.z, s.v, sc)
+            out_x.append(s.x)
+            out_v.append(s.v)
+            out_z.append(s.z)
+            out_i.append(s.ia if phys.current_loop is not None else ic)
+            out_f.append(f)
+            if phys.current_loop is not None:
+                fm = phys.kf * s.ia
+            elif phys.delay is not None:
+                fm = phys.kf * _ic_eff_peek(queue, ic_eff, time, tol)
+            else:
+                fm = phys.kf * ic_eff
+            out_fm.append(s.fl if phys.lag_w is not None else fm)
+            k += 1
+        if k == n_out:
+            break
+        nxt = min(tc, tl[k])
+        msteps = max(math.ceil((nxt - time) / h_max - 1e-6), 1)
+        h = (nxt - time) / msteps
+        for j in range(msteps):
+            tj = time + j * h
+            if phys.delay is not None:
+                while queue and queue[0][0] <= tj + tol:
+                    ic_eff = queue.popleft()[1]
+            step(s, ic_eff, h, tj)
+        if not (math.isfinite(s.x) and math.isfinite(s.v) and math.isfinite(s.z)):
+            raise DataError(
+                f"data: the simulation diverged at t = {time}: check the controller gains "
+                "against the mass and the control rate"
+            )
+        time = nxt
+    return SimResult(ta.copy(), out_x, out_v, out_z, out_i, out_f, out_fm)
