@@ -1,6 +1,6 @@
 //! Static (Stribeck) identification on the shared paper-axis data sets.
 
-use lugre::estimate::{fit_static, StaticFitOptions};
+use lugre::estimate::{fit_static, plateaus_from_recording, PlateauOptions, StaticFitOptions};
 use std::path::PathBuf;
 
 fn dataset(rel: &str) -> Option<PathBuf> {
@@ -144,4 +144,48 @@ fn paper_axis_points_least_squares_is_worse() {
     eprintln!("least squares worst relative error {worst}");
     assert!(worst > 0.02);
     assert!(fit.rejected.is_empty());
+}
+
+#[test]
+fn paper_axis_plateaus() {
+    let (Some(p), Some(t)) = (dataset("static/paper_axis_plateaus.csv"), truth()) else {
+        return;
+    };
+    let c = read_csv(&p);
+    let force: Vec<f64> = c[2].iter().map(|i| 25.0 * i).collect();
+    let opts = PlateauOptions {
+        chunks: 3,
+        ..Default::default()
+    };
+    let pl = plateaus_from_recording(&c[0], &c[1], &force, Some(&c[3]), &opts).unwrap();
+    assert_eq!(pl.segment_start.len(), 14);
+    let settled: Vec<f64> = pl
+        .segment_velocity
+        .iter()
+        .zip(&pl.segment_settled)
+        .filter(|(_, s)| **s)
+        .map(|(v, _)| *v)
+        .collect();
+    eprintln!("settled plateaus {settled:?}");
+    for n in &pl.notes {
+        eprintln!("  {n}");
+    }
+    // the 0.3 and 1 mm/s plateaus creep in presliding and never settle
+    assert!(settled.iter().all(|v| v.abs() >= 0.003));
+    let fit = fit_static(&pl.v, &pl.f, &StaticFitOptions::default()).unwrap();
+    let ep = rel_errors(&fit.positive.set, &t.pos);
+    let en = rel_errors(&fit.negative.set, &t.neg);
+    eprintln!(
+        "positive {:?} rel err {ep:?} se {:?}",
+        fit.positive.set, fit.positive.std_err
+    );
+    eprintln!(
+        "negative {:?} rel err {en:?} se {:?}",
+        fit.negative.set, fit.negative.std_err
+    );
+    eprintln!("rejected {:?}, notes {:?}", fit.rejected, fit.notes);
+    // fc and sigma2 are determined by the fast plateaus
+    for e in [ep[0], ep[2], en[0], en[2]] {
+        assert!(e.abs() < 0.02, "{ep:?} {en:?}");
+    }
 }

@@ -53,12 +53,11 @@ pub(crate) fn irls(
         };
         let r = minimize(&mut f, &theta, &step, &setup.nm);
         evals += r.evals;
-        let dtheta = r
-            .x
-            .iter()
-            .zip(&theta)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0f64, f64::max);
+        let dtheta =
+            r.x.iter()
+                .zip(&theta)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0f64, f64::max);
         theta = r.x;
         e = residuals(&theta)?;
         evals += 1;

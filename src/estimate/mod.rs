@@ -13,11 +13,11 @@
 // pub mod dynamic_fit;
 mod irls;
 pub mod nelder_mead;
-// pub mod plateaus;
+pub mod plateaus;
 pub mod robust;
 pub mod static_fit;
 
 // pub use dynamic_fit::{fit_dynamic, DynamicFit, DynamicFitOptions};
-// pub use plateaus::{plateaus_from_recording, PlateauOptions, Plateaus};
+pub use plateaus::{plateaus_from_recording, PlateauOptions, Plateaus};
 pub use robust::{median, quantile, robust_scale, Weighting};
 pub use static_fit::{fit_static, DirectionFit, StaticFit, StaticFitOptions};

@@ -85,7 +85,14 @@ pub fn minimize(
     }
     let mut converged = false;
     for round in 0..=opts.restarts {
-        let (x, fx, e, conv) = run(f, &best_x, best_f, step, opts, opts.max_evals.saturating_sub(evals));
+        let (x, fx, e, conv) = run(
+            f,
+            &best_x,
+            best_f,
+            step,
+            opts,
+            opts.max_evals.saturating_sub(evals),
+        );
         evals += e;
         let improved = fx < best_f;
         if fx <= best_f {
@@ -218,7 +225,9 @@ fn run(
             sf[i] = eval(&sx[i], &mut evals);
         }
     }
-    let ib = (0..=n).min_by(|&a, &b| sf[a].total_cmp(&sf[b])).unwrap_or(0);
+    let ib = (0..=n)
+        .min_by(|&a, &b| sf[a].total_cmp(&sf[b]))
+        .unwrap_or(0);
     (sx[ib].clone(), sf[ib], evals, converged)
 }
 
@@ -243,7 +252,13 @@ mod tests {
 
     #[test]
     fn nan_region_avoided() {
-        let mut f = |x: &[f64]| if x[0] < 0.0 { f64::NAN } else { (x[0] - 0.1).powi(2) };
+        let mut f = |x: &[f64]| {
+            if x[0] < 0.0 {
+                f64::NAN
+            } else {
+                (x[0] - 0.1).powi(2)
+            }
+        };
         let r = minimize(&mut f, &[1.0], &[0.5], &NmOptions::default());
         assert!((r.x[0] - 0.1).abs() < 1e-6);
     }

@@ -81,7 +81,9 @@ impl Weighting {
             "none" | "ls" | "least_squares" => Ok(Weighting::None),
             other => Err(Error::input(
                 "weighting",
-                format!("unknown weighting \"{other}\": use \"igg\", \"huber\", \"tukey\" or \"none\""),
+                format!(
+                    "unknown weighting \"{other}\": use \"igg\", \"huber\", \"tukey\" or \"none\""
+                ),
             )),
         }
     }

@@ -179,7 +179,9 @@ fn start_values(a: &[f64], y: &[f64]) -> [f64; 4] {
             best = Some((score, p));
         }
     }
-    let mut p = best.map(|b| b.1).unwrap_or([fscale, 1.5 * fscale, 0.0, amax]);
+    let mut p = best
+        .map(|b| b.1)
+        .unwrap_or([fscale, 1.5 * fscale, 0.0, amax]);
     // keep inside the parametrisation (all positive, fs > fc)
     p[0] = p[0].max(1e-3 * fscale);
     p[1] = p[1].max(p[0] * 1.01 + 1e-6 * fscale);
@@ -205,7 +207,12 @@ fn fit_direction(
         if !p.iter().all(|v| v.is_finite() && *v > 0.0) {
             return None;
         }
-        Some(a.iter().zip(y).map(|(&ai, &yi)| yi - curve(&p, ai)).collect())
+        Some(
+            a.iter()
+                .zip(y)
+                .map(|(&ai, &yi)| yi - curve(&p, ai))
+                .collect(),
+        )
     };
     let objective = |e: &[f64], w: &[f64]| e.iter().zip(w).map(|(ei, wi)| wi * ei * ei).sum();
     let step = [0.1, 0.3, 0.1, 0.3];
@@ -249,7 +256,11 @@ fn fit_direction(
         .zip(&out.weights)
         .map(|(e, w)| w * e * e)
         .sum();
-    let sigma = if dof > 0.0 { (ssq / dof).sqrt() } else { f64::NAN };
+    let sigma = if dof > 0.0 {
+        (ssq / dof).sqrt()
+    } else {
+        f64::NAN
+    };
     let mut jtwj = DMatrix::<f64>::zeros(4, 4);
     for i in 0..n {
         let r = j.row(i);
@@ -336,7 +347,10 @@ fn fit_direction(
 pub fn fit_static(v: &[f64], f: &[f64], opts: &StaticFitOptions) -> Result<StaticFit> {
     check_len("f", f, v.len(), "v")?;
     if v.is_empty() {
-        return Err(Error::input("v", "is empty: give steady-state (v, F) points"));
+        return Err(Error::input(
+            "v",
+            "is empty: give steady-state (v, F) points",
+        ));
     }
     check_finite("v", v)?;
     check_finite("f", f)?;
@@ -451,8 +465,14 @@ mod tests {
         assert!(fit.rejected.is_empty(), "{:?}", fit.rejected);
         let p = fit.positive.set;
         let n = fit.negative.set;
-        assert!((p.fc - 10.0).abs() < 1e-4 && (p.vs - 0.02).abs() < 1e-7, "{p:?}");
-        assert!((n.fs - 14.0).abs() < 1e-4 && (n.sigma2 - 40.0).abs() < 1e-3, "{n:?}");
+        assert!(
+            (p.fc - 10.0).abs() < 1e-4 && (p.vs - 0.02).abs() < 1e-7,
+            "{p:?}"
+        );
+        assert!(
+            (n.fs - 14.0).abs() < 1e-4 && (n.sigma2 - 40.0).abs() < 1e-3,
+            "{n:?}"
+        );
         assert!(fit.negative.residuals.iter().all(|e| e.abs() < 1e-5));
     }
 }
