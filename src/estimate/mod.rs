@@ -10,14 +10,14 @@
 //! Both minimise weighted objectives with [`nelder_mead::minimize`] inside an IRLS loop
 //! whose weights come from a robust [`Weighting`] (IGG by default, as in the paper).
 
-// pub mod dynamic_fit;
+pub mod dynamic_fit;
 mod irls;
 pub mod nelder_mead;
 pub mod plateaus;
 pub mod robust;
 pub mod static_fit;
 
-// pub use dynamic_fit::{fit_dynamic, DynamicFit, DynamicFitOptions};
+pub use dynamic_fit::{fit_dynamic, DynamicFit, DynamicFitOptions};
 pub use plateaus::{plateaus_from_recording, PlateauOptions, Plateaus};
 pub use robust::{median, quantile, robust_scale, Weighting};
 pub use static_fit::{fit_static, DirectionFit, StaticFit, StaticFitOptions};

@@ -39,6 +39,8 @@ pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
     }
 }
 
+type ArrayPair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
 fn slice<'a>(name: &str, a: &'a PyReadonlyArray1<'_, f64>) -> Result<&'a [f64], Error> {
     a.as_slice()
         .map_err(|_| Error::input(name, "must be a contiguous 1-D float64 array"))
@@ -78,7 +80,7 @@ fn friction_force<'py>(
     model_json: &str,
     z0: f64,
     return_z: bool,
-) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+) -> PyResult<ArrayPair<'py>> {
     let m = parse_model(py, model_json)?;
     let p = m.friction;
     let vs = slice("v", &v).map_err(|e| to_py(py, e))?;

@@ -1,0 +1,468 @@
+//! Step 2 of the paper's identification: the bristle stiffness `sigma0` and damping
+//! `sigma1` from a closed-loop position record.
+//!
+//! With the static sets held, the PID position loop is simulated
+//! ([`crate::servo::simulate`]) for trial `(sigma0, sigma1)` and the objective of the
+//! paper's eq. 18, `J = c1*sum(w*e^2) + c2*max|e|` over the points with `w > 0`,
+//! `e = x_measured - x_sim`, is minimised by Nelder-Mead over `(ln sigma0, ln sigma1)`
+//! inside an IRLS loop. A coarse grid, simulated in parallel (rayon), gives the start.
+//!
+//! The uncertainty comes from the weighted Jacobian of the position residuals
+//! (central differences in the log-parameters), inflated for the serial correlation of
+//! the residuals (AR(1) variance factor `(1 + rho)/(1 - rho)`): successive position
+//! samples of a servo record are far from independent. Each parameter gets a verdict:
+//! with the paper's axis, `sigma0` shapes the whole presliding phase and is well
+//! determined, while `sigma1` acts only during the short transitions and is confounded
+//! with `sigma2` (the presliding damping is `sigma1 + sigma2`), so it is often not.
+
+use super::irls::{irls, IrlsSetup};
+use super::nelder_mead::NmOptions;
+use super::robust::Weighting;
+use crate::error::{check_finite, check_len, check_time, Error, Result};
+use crate::servo::{simulate, ControlLaw, Drive, Model, SimOptions};
+use rayon::prelude::*;
+
+/// Options of [`fit_dynamic`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DynamicFitOptions {
+    /// Weight function (IGG by default).
+    pub weighting: Weighting,
+    /// Weight of the sum of squares in eq. 18 (1 by default).
+    pub c1: f64,
+    /// Weight of the maximum absolute error in eq. 18 [1/m] (0 by default: the max
+    /// term is non-smooth and the paper gives no value; scale it to the record, e.g.
+    /// `c2 = 0.1*N*typical_error` to give it a tenth of the weight).
+    pub c2: f64,
+    /// Start value of sigma0 (default: the model's).
+    pub sigma0_start: Option<f64>,
+    /// Start value of sigma1 (default: the model's).
+    pub sigma1_start: Option<f64>,
+    /// Evaluate a coarse grid (a factor 10 either side of the start) first.
+    pub grid: bool,
+    /// Maximum IRLS (outer) iterations.
+    pub max_iter: usize,
+    /// Stop when the log-parameters move by less than this.
+    pub tol: f64,
+    /// Simulations per Nelder-Mead run.
+    pub max_evals: usize,
+    /// Lower bound of the residual scale [m] (e.g. the encoder resolution).
+    pub scale_floor: f64,
+    /// Relative uncertainty of sigma2 from the static step, for the note on sigma1
+    /// (0.01 by default).
+    pub sigma2_rel_uncertainty: f64,
+    /// Simulation options (substeps, integrator, initial state).
+    pub sim: SimOptions,
+}
+
+impl Default for DynamicFitOptions {
+    fn default() -> Self {
+        Self {
+            weighting: Weighting::igg(),
+            c1: 1.0,
+            c2: 0.0,
+            sigma0_start: None,
+            sigma1_start: None,
+            grid: true,
+            max_iter: 20,
+            tol: 1e-4,
+            max_evals: 200,
+            scale_floor: 0.0,
+            sigma2_rel_uncertainty: 0.01,
+            sim: SimOptions::default(),
+        }
+    }
+}
+
+/// Result of [`fit_dynamic`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct DynamicFit {
+    /// Estimated bristle stiffness [N/m].
+    pub sigma0: f64,
+    /// Estimated bristle damping [N s/m].
+    pub sigma1: f64,
+    /// Standard errors of `sigma0, sigma1` (delta method; NaN when unavailable).
+    pub std_err: Vec<f64>,
+    /// Lower ends of the 95 % intervals of `sigma0, sigma1` (from the log-parameters).
+    pub ci_low: Vec<f64>,
+    /// Upper ends of the 95 % intervals.
+    pub ci_high: Vec<f64>,
+    /// Half-width of each interval relative to the estimate.
+    pub rel_ci_half_width: Vec<f64>,
+    /// Verdict per parameter: true when it is determined by the record.
+    pub identifiable: Vec<bool>,
+    /// Correlation of the `ln sigma0` and `ln sigma1` estimates.
+    pub correlation: f64,
+    /// Lag-one autocorrelation of the weighted residuals (used to widen the intervals).
+    pub residual_autocorrelation: f64,
+    /// Plain-language verdicts and suggested experiments.
+    pub notes: Vec<String>,
+    /// `x_measured - x_sim` at the estimate [m].
+    pub residuals: Vec<f64>,
+    /// Final IRLS weights (0 = rejected sample).
+    pub weights: Vec<f64>,
+    /// Root mean square of the weighted residuals [m].
+    pub rms_error: f64,
+    /// Largest absolute residual among the kept samples [m].
+    pub max_error: f64,
+    /// Eq. 18 objective at the estimate.
+    pub objective: f64,
+    /// Robust scale of the residuals [m].
+    pub scale: f64,
+    /// IRLS iterations.
+    pub iterations: usize,
+    /// Closed-loop simulations run.
+    pub evaluations: usize,
+    /// True when IRLS settled before `max_iter`.
+    pub converged: bool,
+}
+
+fn with_sigmas(model: &Model, s0: f64, s1: f64) -> Model {
+    let mut m = model.clone();
+    m.friction.sigma0 = s0;
+    m.friction.sigma1 = s1;
+    m
+}
+
+fn check_options(o: &DynamicFitOptions) -> Result<()> {
+    o.weighting.validate()?;
+    for (name, v) in [
+        ("c1", o.c1),
+        ("c2", o.c2),
+        ("scale_floor", o.scale_floor),
+        ("sigma2_rel_uncertainty", o.sigma2_rel_uncertainty),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(Error::parameter(
+                name,
+                v,
+                "must be finite and zero or greater",
+            ));
+        }
+    }
+    if o.c1 == 0.0 && o.c2 == 0.0 {
+        return Err(Error::parameter("c1", 0.0, "c1 and c2 cannot both be zero"));
+    }
+    for (name, v) in [
+        ("sigma0_start", o.sigma0_start),
+        ("sigma1_start", o.sigma1_start),
+    ] {
+        if let Some(x) = v {
+            if !(x.is_finite() && x > 0.0) {
+                return Err(Error::parameter(
+                    name,
+                    x,
+                    "must be a finite number greater than zero",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Estimate `sigma0` and `sigma1` from a closed-loop position record.
+///
+/// `model` holds the axis, the static friction sets (held fixed) and a `pid`
+/// controller; `t`, `x_ref`, `x_measured` the record (same length). The model's
+/// `sigma0`, `sigma1` are the start values unless the options give others.
+///
+/// ```no_run
+/// use lugre::estimate::{fit_dynamic, DynamicFitOptions};
+/// use lugre::servo::{simulate, Drive, Model, SimOptions};
+/// let m = Model::from_json(r#"{"axis": {"mass": 25, "force_constant": 25},
+///   "friction": {"sigma0": 1e5, "sigma1": 31.62,
+///     "positive": {"fc": 28.7, "fs": 60.2, "sigma2": 332.5, "vs": 0.01},
+///     "negative": {"fc": 28.5, "fs": 60.1, "sigma2": 333.0, "vs": 0.01}},
+///   "controller": {"type": "pid", "kp": 5e4, "ki": 5e5, "kd": 1500, "rate_hz": 10000}}"#).unwrap();
+/// let t: Vec<f64> = (0..20001).map(|k| k as f64 * 1e-4).collect();
+/// let xr: Vec<f64> = t.iter().map(|&s| 1e-3 * s).collect();
+/// let x = simulate(&m, &t, Drive::Position(&xr), &SimOptions::default(), &mut || true).unwrap().x;
+/// let mut start = m.clone();
+/// start.friction.sigma0 = 5e4;
+/// let fit = fit_dynamic(&start, &t, &xr, &x, &DynamicFitOptions::default()).unwrap();
+/// assert!((fit.sigma0 / 1e5 - 1.0).abs() < 1e-3);
+/// ```
+pub fn fit_dynamic(
+    model: &Model,
+    t: &[f64],
+    x_ref: &[f64],
+    x_measured: &[f64],
+    opts: &DynamicFitOptions,
+) -> Result<DynamicFit> {
+    check_time("t", t)?;
+    check_len("x_ref", x_ref, t.len(), "t")?;
+    check_len("x_measured", x_measured, t.len(), "t")?;
+    check_finite("x_ref", x_ref)?;
+    check_finite("x_measured", x_measured)?;
+    check_options(opts)?;
+    match model.controller.as_ref().map(|c| c.law) {
+        Some(ControlLaw::Pid { .. }) => {}
+        _ => {
+            return Err(Error::model(
+                "controller",
+                "fit_dynamic needs a \"pid\" position controller (the loop of the record)",
+            ))
+        }
+    }
+    if t.len() < 10 {
+        return Err(Error::Data(format!(
+            "{} samples: a dynamic fit needs a record of many control periods",
+            t.len()
+        )));
+    }
+    // a record that never moves holds no information on the bristles
+    let span = x_measured.iter().fold(f64::NEG_INFINITY, |m, &x| m.max(x))
+        - x_measured.iter().fold(f64::INFINITY, |m, &x| m.min(x));
+    if span <= 0.0 {
+        return Err(Error::Data(
+            "x_measured is constant: record a motion (a slow ramp that sticks and slips)".into(),
+        ));
+    }
+    let sim_opts = opts.sim;
+    // check the model runs at all (errors in the model or inputs surface here)
+    simulate(model, t, Drive::Position(x_ref), &sim_opts, &mut || true)?;
+
+    let resid = |th: &[f64]| -> Option<Vec<f64>> {
+        let (s0, s1) = (th[0].exp(), th[1].exp());
+        if !(s0.is_finite() && s1.is_finite() && s0 > 0.0) {
+            return None;
+        }
+        let m = with_sigmas(model, s0, s1);
+        let r = simulate(&m, t, Drive::Position(x_ref), &sim_opts, &mut || true).ok()?;
+        Some(x_measured.iter().zip(&r.x).map(|(a, b)| a - b).collect())
+    };
+    let (c1, c2) = (opts.c1, opts.c2);
+    let objective = move |e: &[f64], w: &[f64]| -> f64 {
+        let mut ss = 0.0;
+        let mut mx = 0.0f64;
+        for (ei, wi) in e.iter().zip(w) {
+            ss += wi * ei * ei;
+            if *wi > 0.0 {
+                mx = mx.max(ei.abs());
+            }
+        }
+        c1 * ss + c2 * mx
+    };
+
+    let s0_start = opts.sigma0_start.unwrap_or(model.friction.sigma0);
+    let s1_start = opts.sigma1_start.unwrap_or(model.friction.sigma1).max(1e-6);
+    let mut theta0 = vec![s0_start.ln(), s1_start.ln()];
+    let mut evaluations = 0usize;
+    let ln10 = std::f64::consts::LN_10;
+    let mut step = vec![0.2, 0.5];
+    if opts.grid {
+        let mut nodes = Vec::new();
+        for i in 0..7 {
+            for j in 0..5 {
+                nodes.push([
+                    theta0[0] + ln10 * (i as f64 - 3.0) / 3.0,
+                    theta0[1] + ln10 * (j as f64 - 2.0) / 2.0,
+                ]);
+            }
+        }
+        let ones = vec![1.0; t.len()];
+        let scores: Vec<f64> = nodes
+            .par_iter()
+            .map(|th| match resid(th) {
+                Some(e) => objective(&e, &ones),
+                None => f64::INFINITY,
+            })
+            .collect();
+        evaluations += nodes.len();
+        if let Some(k) = (0..nodes.len())
+            .filter(|&k| scores[k].is_finite())
+            .min_by(|&a, &b| scores[a].total_cmp(&scores[b]))
+        {
+            theta0 = nodes[k].to_vec();
+            step = vec![ln10 / 6.0, ln10 / 4.0];
+        }
+    }
+    let setup = IrlsSetup {
+        weighting: opts.weighting,
+        max_outer: opts.max_iter,
+        tol: opts.tol,
+        scale_floor: opts.scale_floor,
+        nm: NmOptions {
+            max_evals: opts.max_evals,
+            xtol: opts.tol.max(1e-8),
+            ftol: 1e-10,
+            restarts: 1,
+        },
+        step: &step,
+    };
+    let out = irls(&resid, &objective, theta0, &setup).ok_or_else(|| {
+        Error::Data(
+            "the closed loop could not be simulated at the start values: give sigma0_start and sigma1_start near the expected values".into(),
+        )
+    })?;
+    evaluations += out.evals;
+    let th = out.theta.clone();
+    let (s0, s1) = (th[0].exp(), th[1].exp());
+
+    // Jacobian of the residuals by central differences in the log-parameters
+    let h = 1e-3;
+    let probes: Vec<[f64; 2]> = vec![
+        [th[0] + h, th[1]],
+        [th[0] - h, th[1]],
+        [th[0], th[1] + h],
+        [th[0], th[1] - h],
+    ];
+    let sims: Vec<Option<Vec<f64>>> = probes.par_iter().map(|p| resid(p)).collect();
+    evaluations += 4;
+    let w = &out.weights;
+    let e = &out.residuals;
+    let n_used = w.iter().filter(|x| **x > 0.0).count();
+    let mut notes = Vec::new();
+    let mut std_err = vec![f64::NAN; 2];
+    let mut ci_low = vec![f64::NAN; 2];
+    let mut ci_high = vec![f64::NAN; 2];
+    let mut rel = vec![f64::INFINITY; 2];
+    let mut correlation = f64::NAN;
+    // lag-one autocorrelation of the kept residuals
+    let mut num = 0.0;
+    let mut den = 0.0;
+    for k in 0..e.len() {
+        if w[k] > 0.0 {
+            den += w[k] * e[k] * e[k];
+            if k + 1 < e.len() && w[k + 1] > 0.0 {
+                num += (w[k] * w[k + 1]).sqrt() * e[k] * e[k + 1];
+            }
+        }
+    }
+    let rho = if den > 0.0 {
+        (num / den).clamp(0.0, 0.999)
+    } else {
+        0.0
+    };
+    let inflation = (1.0 + rho) / (1.0 - rho);
+    let mut singular = false;
+    if let [Some(a), Some(b), Some(c), Some(d)] = &sims[..] {
+        // de/dtheta = -(dx_sim/dtheta); the sign does not matter for J^T W J
+        let mut m = [[0.0f64; 2]; 2];
+        for k in 0..e.len() {
+            let j0 = (a[k] - b[k]) / (2.0 * h);
+            let j1 = (c[k] - d[k]) / (2.0 * h);
+            m[0][0] += w[k] * j0 * j0;
+            m[0][1] += w[k] * j0 * j1;
+            m[1][1] += w[k] * j1 * j1;
+        }
+        m[1][0] = m[0][1];
+        let dof = n_used as f64 - 2.0;
+        let ssq: f64 = e.iter().zip(w).map(|(ei, wi)| wi * ei * ei).sum();
+        let s2 = if dof > 0.0 { ssq / dof } else { f64::NAN };
+        let det = m[0][0] * m[1][1] - m[0][1] * m[0][1];
+        let scale = (m[0][0] * m[1][1]).max(0.0);
+        let cond_ok = scale > 0.0 && det > 1e-10 * scale;
+        if cond_ok && s2.is_finite() {
+            let c00 = m[1][1] / det * s2 * inflation;
+            let c11 = m[0][0] / det * s2 * inflation;
+            let c01 = -m[0][1] / det * s2 * inflation;
+            correlation = c01 / (c00 * c11).sqrt();
+            let se_th = [c00.sqrt(), c11.sqrt()];
+            let est = [s0, s1];
+            for k in 0..2 {
+                std_err[k] = est[k] * se_th[k];
+                ci_low[k] = est[k] * (-1.96 * se_th[k]).exp();
+                ci_high[k] = est[k] * (1.96 * se_th[k]).exp();
+                rel[k] = (ci_high[k] - ci_low[k]) / (2.0 * est[k]);
+            }
+        } else {
+            singular = true;
+        }
+    } else {
+        singular = true;
+        notes.push("the simulation failed next to the estimate: no intervals".into());
+    }
+    let mut identifiable = vec![false; 2];
+    for k in 0..2 {
+        identifiable[k] = !singular && rel[k].is_finite() && rel[k] <= 0.5;
+    }
+    if singular {
+        notes.push(
+            "the objective is flat in at least one direction (near-singular Hessian): sigma0 and sigma1 cannot be separated by this record".into(),
+        );
+    }
+    if identifiable[0] {
+        notes.push(format!(
+            "sigma0 = {s0:.4e} N/m is determined by the record (95 % interval +-{:.2} %)",
+            rel[0] * 100.0
+        ));
+    } else {
+        notes.push(format!(
+            "sigma0 is NOT determined by this record (95 % interval +-{:.0} %): record small back-and-forth moves below the break-away force (presliding), where the force-displacement slope is sigma0",
+            rel[0] * 100.0
+        ));
+    }
+    if identifiable[1] {
+        notes.push(format!(
+            "sigma1 = {s1:.4} N s/m is determined by the record (95 % interval +-{:.1} %)",
+            rel[1] * 100.0
+        ));
+    } else {
+        notes.push(format!(
+            "sigma1 is NOT determined by this record: the objective is nearly flat in sigma1 (95 % interval +-{:.0} %). Break-away tests with small displacements (force ramps or steps below fs, with fast position sampling) excite the bristle damping; otherwise keep the start value and report it as assumed",
+            rel[1].min(1e6) * 100.0
+        ));
+    }
+    let s2max = model
+        .friction
+        .positive
+        .sigma2
+        .max(model.friction.negative.sigma2);
+    let bias = s2max * opts.sigma2_rel_uncertainty;
+    if bias > 0.1 * s1 {
+        notes.push(format!(
+            "sigma1 is confounded with sigma2 (the presliding damping is sigma1 + sigma2): a {:.1} % error in sigma2 ({bias:.3} N s/m) is {:.0} % of sigma1; reduce sigma2's uncertainty (more fast constant-velocity points) before trusting sigma1",
+            opts.sigma2_rel_uncertainty * 100.0,
+            100.0 * bias / s1
+        ));
+    }
+    if rho > 0.5 {
+        notes.push(format!(
+            "residuals are serially correlated (lag-one {rho:.3}); intervals widened by a factor {:.1}",
+            inflation.sqrt()
+        ));
+    }
+    if correlation.abs() > 0.95 {
+        notes.push(format!(
+            "ln sigma0 and ln sigma1 are strongly correlated ({correlation:.3})"
+        ));
+    }
+    if !out.converged {
+        notes.push(format!(
+            "IRLS stopped at the iteration limit ({}) before the weights settled",
+            out.iterations
+        ));
+    }
+    let wsum: f64 = w.iter().sum();
+    let ssq: f64 = e.iter().zip(w).map(|(ei, wi)| wi * ei * ei).sum();
+    let max_error = e
+        .iter()
+        .zip(w)
+        .filter(|(_, wi)| **wi > 0.0)
+        .fold(0.0f64, |m, (ei, _)| m.max(ei.abs()));
+    Ok(DynamicFit {
+        sigma0: s0,
+        sigma1: s1,
+        std_err,
+        ci_low,
+        ci_high,
+        rel_ci_half_width: rel,
+        identifiable,
+        correlation,
+        residual_autocorrelation: rho,
+        notes,
+        objective: objective(e, w),
+        rms_error: if wsum > 0.0 {
+            (ssq / wsum).sqrt()
+        } else {
+            f64::NAN
+        },
+        max_error,
+        scale: out.scale,
+        residuals: out.residuals,
+        weights: out.weights,
+        iterations: out.iterations,
+        evaluations,
+        converged: out.converged,
+    })
+}

@@ -1,0 +1,298 @@
+//! Servo simulation: convergence order, closed-loop behaviour, effects, bad input.
+
+use lugre::servo::{simulate, simulate_batch, Drive, Integrator, Model, SimOptions};
+use lugre::Error;
+
+fn paper(effects: &str, controller: &str) -> Model {
+    Model::from_json(&format!(
+        r#"{{"axis": {{"mass": 25.0, "force_constant": 25.0}},
+        "friction": {{"model": "lugre", "sigma0": 1e5, "sigma1": 31.62,
+          "positive": {{"fc": 28.7, "fs": 60.2, "sigma2": 332.5, "vs": 0.01}},
+          "negative": {{"fc": 28.5, "fs": 60.1, "sigma2": 333.0, "vs": 0.01}}}},
+        "effects": [{effects}] {controller}}}"#
+    ))
+    .unwrap()
+}
+
+const PID: &str =
+    r#", "controller": {"type": "pid", "kp": 5e4, "ki": 5e5, "kd": 1500, "rate_hz": 10000}"#;
+
+fn grid(n: usize, dt: f64) -> Vec<f64> {
+    (0..n).map(|k| k as f64 * dt).collect()
+}
+
+fn run(
+    m: &Model,
+    t: &[f64],
+    d: Drive,
+    integrator: Integrator,
+    substeps: usize,
+) -> lugre::servo::SimResult {
+    let o = SimOptions {
+        integrator,
+        substeps,
+        v0: 0.05,
+        ..SimOptions::default()
+    };
+    simulate(m, t, d, &o, &mut || true).unwrap()
+}
+
+/// Halving the plant step: the exact-bristle splitting converges at first order, RK4
+/// at fourth order (open loop, sliding without reversal so the right-hand side is smooth).
+#[test]
+fn integrator_order_by_step_halving() {
+    let m = paper("", "");
+    let t = grid(51, 2e-3);
+    let i = vec![3.0; t.len()]; // 75 N pushes against ~45 N of friction
+    let reference = run(&m, &t, Drive::Current(&i), Integrator::Rk4, 256);
+    let err = |integ, sub| {
+        let r = run(&m, &t, Drive::Current(&i), integ, sub);
+        r.x.iter()
+            .zip(&reference.x)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    };
+    let (e1, e2, e3) = (
+        err(Integrator::Exact, 4),
+        err(Integrator::Exact, 8),
+        err(Integrator::Exact, 16),
+    );
+    for r in [e1 / e2, e2 / e3] {
+        assert!(r > 1.7 && r < 2.3, "exact splitting ratio {r} (want ~2)");
+    }
+    let (e1, e2, e3) = (
+        err(Integrator::Rk4, 1),
+        err(Integrator::Rk4, 2),
+        err(Integrator::Rk4, 4),
+    );
+    for r in [e1 / e2, e2 / e3] {
+        assert!(r > 12.0 && r < 20.0, "rk4 ratio {r} (want ~16)");
+    }
+}
+
+/// A slow ramp pulled through a soft position loop sticks and slips: the velocity drops
+/// to zero again and again, while a fast ramp slides smoothly.
+#[test]
+fn slow_ramp_gives_stick_slip() {
+    let soft = r#", "controller": {"type": "pid", "kp": 1e4, "ki": 0, "kd": 0, "rate_hz": 10000}"#;
+    let m = paper("", soft);
+    let t = grid(40_001, 1e-4);
+    let rate = 0.01;
+    let slow: Vec<f64> = t.iter().map(|&s| rate * s).collect();
+    let r = simulate(
+        &m,
+        &t,
+        Drive::Position(&slow),
+        &SimOptions::default(),
+        &mut || true,
+    )
+    .unwrap();
+    let tail = &r.v[10_000..];
+    let stops = tail
+        .windows(2)
+        .filter(|w| w[0] > 0.1 * rate && w[1] <= 0.1 * rate)
+        .count();
+    let vmax = tail.iter().cloned().fold(0.0, f64::max);
+    assert!(stops >= 3, "stick-slip expected, {stops} stops");
+    assert!(
+        vmax > 2.0 * rate,
+        "slip phases faster than the ramp, vmax {vmax}"
+    );
+    let fast: Vec<f64> = t.iter().map(|&s| 0.2 * s).collect();
+    let r = simulate(
+        &m,
+        &t,
+        Drive::Position(&fast),
+        &SimOptions::default(),
+        &mut || true,
+    )
+    .unwrap();
+    assert!(
+        r.v[20_000..].iter().all(|&v| v > 0.1),
+        "smooth sliding at 0.2 m/s"
+    );
+}
+
+/// Effects act as their formulas say: a constant offset is held by the integral action.
+#[test]
+fn offset_and_spring_are_held_by_the_integrator() {
+    let t = grid(30_001, 1e-4);
+    let hold = vec![0.0; t.len()];
+    let m = paper(r#"{"effect": "offset", "force": 100.0}"#, PID);
+    let r = simulate(
+        &m,
+        &t,
+        Drive::Position(&hold),
+        &SimOptions::default(),
+        &mut || true,
+    )
+    .unwrap();
+    let i_end = *r.i.last().unwrap();
+    let f_end = *r.friction.last().unwrap();
+    // motor force balances offset plus whatever the bristles still carry
+    assert!(
+        (25.0 * i_end - 100.0 - f_end).abs() < 1.0,
+        "{i_end} {f_end}"
+    );
+    let m = paper(
+        r#"{"effect": "spring", "stiffness": 2000.0, "x0": -0.05}"#,
+        PID,
+    );
+    let r = simulate(
+        &m,
+        &t,
+        Drive::Position(&hold),
+        &SimOptions::default(),
+        &mut || true,
+    )
+    .unwrap();
+    let x_end = *r.x.last().unwrap();
+    let want = 2000.0 * (x_end + 0.05) + r.friction.last().unwrap();
+    assert!((25.0 * r.i.last().unwrap() - want).abs() < 1.0);
+}
+
+/// Mass, delay and lag change an open-loop response the expected way.
+#[test]
+fn mass_delay_and_lag() {
+    let t = grid(101, 1e-3);
+    let i = vec![4.0; t.len()];
+    let o = SimOptions::default();
+    let base = simulate(&paper("", ""), &t, Drive::Current(&i), &o, &mut || true).unwrap();
+    let heavy = simulate(
+        &paper(r#"{"effect": "mass", "delta": 25.0}"#, ""),
+        &t,
+        Drive::Current(&i),
+        &o,
+        &mut || true,
+    )
+    .unwrap();
+    assert!(heavy.x[100] < 0.7 * base.x[100]);
+    let late = simulate(
+        &paper(r#"{"effect": "delay", "seconds": 0.01}"#, ""),
+        &t,
+        Drive::Current(&i),
+        &o,
+        &mut || true,
+    )
+    .unwrap();
+    assert_eq!(late.x[10], 0.0); // no force before 10 ms
+    assert!(late.force[11] > 99.0);
+    let lag = simulate(
+        &paper(r#"{"effect": "current_lag", "bandwidth": 50.0}"#, ""),
+        &t,
+        Drive::Current(&i),
+        &o,
+        &mut || true,
+    )
+    .unwrap();
+    let tau = 1.0 / (2.0 * std::f64::consts::PI * 50.0);
+    let want = 100.0 * (1.0 - (-0.005f64 / tau).exp());
+    assert!(
+        (lag.force[5] - want).abs() < 0.5,
+        "{} vs {want}",
+        lag.force[5]
+    );
+}
+
+/// Batch results equal one-by-one results.
+#[test]
+fn batch_equals_serial() {
+    let t = grid(2001, 1e-4);
+    let xr: Vec<f64> = t.iter().map(|&s| 0.01 * s).collect();
+    let models: Vec<Model> = (0..4)
+        .map(|k| {
+            let mut m = paper("", PID);
+            m.friction.sigma0 *= 1.0 + 0.1 * k as f64;
+            m
+        })
+        .collect();
+    let o = SimOptions::default();
+    let batch = simulate_batch(&models, &t, Drive::Position(&xr), &o);
+    for (m, b) in models.iter().zip(batch) {
+        let s = simulate(m, &t, Drive::Position(&xr), &o, &mut || true).unwrap();
+        assert_eq!(s, b.unwrap());
+    }
+}
+
+/// Bad input gives errors that name the problem, never a panic.
+#[test]
+fn bad_input_is_an_error() {
+    let m = paper("", PID);
+    let t = vec![0.0, 1e-4, 1e-4];
+    let x = vec![0.0; 3];
+    let e = simulate(
+        &m,
+        &t,
+        Drive::Position(&x),
+        &SimOptions::default(),
+        &mut || true,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, Error::Input { ref name, .. } if name == "t"),
+        "{e}"
+    );
+    assert!(e.to_string().contains("strictly increasing"));
+    let t = grid(3, 1e-4);
+    let e = simulate(
+        &m,
+        &t,
+        Drive::Position(&x[..2]),
+        &SimOptions::default(),
+        &mut || true,
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("x_ref") && e.to_string().contains("same length"),
+        "{e}"
+    );
+    let e = simulate(
+        &m,
+        &[],
+        Drive::Position(&[]),
+        &SimOptions::default(),
+        &mut || true,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("empty"));
+    let bad = vec![0.0, f64::NAN, 0.0];
+    let e = simulate(
+        &m,
+        &t,
+        Drive::Position(&bad),
+        &SimOptions::default(),
+        &mut || true,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("element 1"));
+    let e = simulate(
+        &paper("", ""),
+        &t,
+        Drive::Position(&x),
+        &SimOptions::default(),
+        &mut || true,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("controller"));
+    let e = simulate(
+        &m,
+        &t,
+        Drive::Speed(&x),
+        &SimOptions::default(),
+        &mut || true,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("x_ref"));
+    // interruption
+    let long = grid(200_000, 1e-4);
+    let xr = vec![0.0; long.len()];
+    let e = simulate(
+        &m,
+        &long,
+        Drive::Position(&xr),
+        &SimOptions::default(),
+        &mut || false,
+    )
+    .unwrap_err();
+    assert_eq!(e, Error::Interrupted);
+}
