@@ -19,10 +19,7 @@ pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
         Error::Interrupted => return PyKeyboardInterrupt::new_err("interrupted"),
     };
     let msg = e.to_string();
-    match py
-        .import("lugre.exceptions")
-        .and_then(|m| m.getattr(class))
-    {
+    match py.import("lugre.exceptions").and_then(|m| m.getattr(class)) {
         Ok(cls) => {
             let err = match cls.call1((msg.clone(),)) {
                 Ok(inst) => PyErr::from_value(inst),
@@ -85,9 +82,34 @@ fn friction_force<'py>(
     let p = m.friction;
     let vs = slice("v", &v).map_err(|e| to_py(py, e))?;
     let dts = slice("dt", &dt).map_err(|e| to_py(py, e))?;
+    (|| -> Result<(), Error> {
+        check_finite("v", vs)?;
+        if dts.is_empty() {
+            return Err(Error::input("dt", "is empty: give the hold interval [s]"));
+        }
+        if dts.len() != 1 {
+            crate::error::check_len("dt", dts, vs.len(), "v")?;
+        }
+        check_finite("dt", dts)?;
+        if let Some(k) = dts.iter().position(|&h| h < 0.0) {
+            return Err(Error::input(
+                "dt",
+                format!("element {k} is {}: hold intervals must be >= 0", dts[k]),
+            ));
+        }
+        if !z0.is_finite() {
+            return Err(Error::parameter("z0", z0, "must be finite"));
+        }
+        Ok(())
+    })()
+    .map_err(|e| to_py(py, e))?;
     let (f, z) = py.detach(|| {
         let mut f = vec![0.0; vs.len()];
-        let mut z = if return_z { vec![0.0; vs.len()] } else { Vec::new() };
+        let mut z = if return_z {
+            vec![0.0; vs.len()]
+        } else {
+            Vec::new()
+        };
         let zo = if return_z { Some(&mut z[..]) } else { None };
         if dts.len() == 1 {
             friction_force_into(&p, vs, dts[0], z0, &mut f, zo);
@@ -99,7 +121,13 @@ fn friction_force<'py>(
     Ok((f.into_pyarray(py), z.into_pyarray(py)))
 }
 
-fn parse_opts(integrator: &str, substeps: usize, z0: f64, x0: Option<f64>, v0: f64) -> Result<SimOptions, Error> {
+fn parse_opts(
+    integrator: &str,
+    substeps: usize,
+    z0: f64,
+    x0: Option<f64>,
+    v0: f64,
+) -> Result<SimOptions, Error> {
     let integrator = match integrator {
         "exact" => Integrator::Exact,
         "rk4" => Integrator::Rk4,

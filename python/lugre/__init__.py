@@ -1,0 +1,56 @@
+"""lugre: LuGre friction, servo-axis simulation and robust friction identification.
+
+The public API runs on the Rust core; :mod:`lugre.reference` offers the same functions
+written in NumPy alone, for checking and reading.
+
+>>> import lugre
+>>> m = lugre.Model.paper()
+>>> r = lugre.simulate(m, t, x_ref)          # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+from ._native import friction_force, simulate, simulate_batch, stribeck
+from ._result import SimResult
+from .exceptions import (
+    ConvergenceWarning,
+    DataError,
+    FileFormatError,
+    IdentifiabilityWarning,
+    InputError,
+    LugreError,
+    LugreWarning,
+    ModelError,
+    ParameterError,
+    PassivityWarning,
+    UnitsWarning,
+)
+from .io import Recording, read_recording, write_recording
+from .model import Model, load_model, save_model
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "ConvergenceWarning",
+    "DataError",
+    "FileFormatError",
+    "IdentifiabilityWarning",
+    "InputError",
+    "LugreError",
+    "LugreWarning",
+    "Model",
+    "ModelError",
+    "ParameterError",
+    "PassivityWarning",
+    "Recording",
+    "SimResult",
+    "UnitsWarning",
+    "friction_force",
+    "load_model",
+    "read_recording",
+    "save_model",
+    "simulate",
+    "simulate_batch",
+    "stribeck",
+    "write_recording",
+]

@@ -1,0 +1,217 @@
+"""The public simulation API over the Rust core (:mod:`lugre._core`).
+
+Each function has the same name, signature and results as its twin in
+:mod:`lugre.reference`; Python only normalises inputs (dtype, layout, dimensions) and
+the core validates their content, with the same errors.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from . import _core
+from ._result import SimResult
+from .exceptions import InputError
+from .model import ModelLike, _as_model
+
+__all__ = ["friction_force", "simulate", "simulate_batch", "stribeck"]
+
+
+def _array(name: str, a: Any) -> np.ndarray:
+    """A contiguous 1-D float64 array, or :class:`InputError` naming the argument."""
+    try:
+        arr = np.ascontiguousarray(a, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise InputError.at(name, f"must be an array of numbers ({e})") from None
+    if arr.ndim != 1:
+        raise InputError.at(name, f"must be a 1-D array, got shape {arr.shape}")
+    return arr
+
+
+def _json(model: ModelLike) -> str:
+    return _as_model(model).to_json(indent=None)
+
+
+def stribeck(v: Any, model: ModelLike) -> np.ndarray:
+    """Steady-state (Stribeck) friction force for each velocity.
+
+    ``F_ss(v) = sign(v)*g(v) + sigma2*v`` with the ``positive`` set for ``v >= 0`` and
+    the ``negative`` set for ``v < 0``, and ``F_ss(0) = 0``.
+
+    Parameters
+    ----------
+    v : array_like
+        Velocities [m/s], 1-D.
+    model : Model, dict or path
+        The model (only its friction is used).
+
+    Returns
+    -------
+    numpy.ndarray
+        Forces [N], float64, same length as ``v``.
+
+    Examples
+    --------
+    >>> import lugre
+    >>> float(lugre.stribeck([0.4], lugre.Model.paper())[0])
+    161.7
+    """
+    return _core.stribeck(_array("v", v), _json(model))
+
+
+def friction_force(
+    v: Any,
+    dt: Any,
+    model: ModelLike,
+    *,
+    z0: float = 0.0,
+    return_z: bool = False,
+) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """LuGre friction force driven by a sampled velocity signal (see the reference).
+
+    For ``k = 0 .. n-1``: ``F[k]`` is the force at state ``z`` and ``v[k]``; then ``z``
+    advances exactly over ``dt`` (or ``dt[k]``) with ``v[k]`` held.
+
+    Parameters
+    ----------
+    v : array_like
+        Velocities [m/s], 1-D.
+    dt : float or array_like
+        Hold interval [s]: one value, or one per sample.
+    model : Model, dict or path
+        The model (only its friction is used).
+    z0 : float, default 0.0
+        Initial bristle deflection [m].
+    return_z : bool, default False
+        Also return ``z[k]``, the state at which ``F[k]`` was evaluated.
+
+    Returns
+    -------
+    F : numpy.ndarray
+        Friction force [N].
+    z : numpy.ndarray
+        Only with ``return_z``.
+    """
+    vv = _array("v", v)
+    try:
+        dta = np.ascontiguousarray(dt, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError) as e:
+        raise InputError.at("dt", f"must be a number or an array of numbers ({e})") from None
+    f, z = _core.friction_force(vv, dta, _json(model), _float("z0", z0), bool(return_z))
+    return (f, z) if return_z else f
+
+
+def _float(name: str, value: Any) -> float:
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        from .exceptions import ParameterError
+
+        raise ParameterError.invalid(name, value, "must be a finite number") from None
+
+
+def _drive(x_ref: Any, v_ref: Any, current: Any) -> tuple[str, np.ndarray]:
+    given = [(k, a) for k, a in (("x_ref", x_ref), ("v_ref", v_ref), ("current", current))
+             if a is not None]
+    if len(given) != 1:
+        raise InputError.at(
+            "x_ref",
+            "give exactly one of x_ref (pid), v_ref (pi_speed) or current (open loop)",
+        )
+    name, a = given[0]
+    return name, _array(name, a)
+
+
+def simulate(
+    model: ModelLike,
+    t: Any,
+    x_ref: Any = None,
+    *,
+    v_ref: Any = None,
+    current: Any = None,
+    integrator: str = "exact",
+    substeps: int = 1,
+    z0: float = 0.0,
+    x0: float | None = None,
+    v0: float = 0.0,
+) -> SimResult:
+    """Simulate the axis under its controller (or in open loop), sampled at ``t``.
+
+    Runs in the Rust core with the interpreter released; Ctrl-C interrupts it. The
+    parameters and results are those of :func:`lugre.reference.simulate`.
+
+    Parameters
+    ----------
+    model : Model, dict or path
+        The axis model. Closed loop needs its ``controller``.
+    t : array_like
+        Sample times [s], strictly increasing.
+    x_ref, v_ref, current : array_like, optional
+        Exactly one: position reference (pid), speed reference (pi_speed) or open-loop
+        current command [A], each sampled at ``t``.
+    integrator : {"exact", "rk4"}, default "exact"
+        Plant integrator.
+    substeps : int, default 1
+        Plant steps per control period (per sample interval in open loop).
+    z0, x0, v0 : float
+        Initial bristle deflection, position (default ``x_ref[0]`` or 0) and velocity.
+
+    Returns
+    -------
+    SimResult
+        ``t``, ``x``, ``v``, ``z``, ``i``, ``friction`` and ``force`` at ``t``.
+    """
+    tt = _array("t", t)
+    kind, d = _drive(x_ref, v_ref, current)
+    sub = _substeps(substeps)
+    r = _core.simulate(_json(model), tt, kind, d, str(integrator), sub, _float("z0", z0),
+                       None if x0 is None else _float("x0", x0), _float("v0", v0))
+    return SimResult(t=tt.copy(), **r)
+
+
+def _substeps(substeps: Any) -> int:
+    from .exceptions import ParameterError
+
+    try:
+        sub = int(substeps)
+    except (TypeError, ValueError):
+        raise ParameterError.invalid("substeps", substeps, "must be a whole number >= 1") from None
+    if sub < 1 or sub != substeps:
+        raise ParameterError.invalid("substeps", substeps, "must be a whole number >= 1")
+    return sub
+
+
+def simulate_batch(
+    models: Sequence[ModelLike],
+    t: Any,
+    x_ref: Any = None,
+    *,
+    v_ref: Any = None,
+    current: Any = None,
+    integrator: str = "exact",
+    substeps: int = 1,
+    z0: float = 0.0,
+    x0: float | None = None,
+    v0: float = 0.0,
+) -> list[SimResult]:
+    """Simulate many models on the same input, in parallel on all cores.
+
+    Parameters are those of :func:`simulate`, with a sequence of models.
+
+    Returns
+    -------
+    list of SimResult
+        One per model, in order.
+    """
+    tt = _array("t", t)
+    kind, d = _drive(x_ref, v_ref, current)
+    sub = _substeps(substeps)
+    texts = [_json(m) for m in models]
+    rs = _core.simulate_batch(texts, tt, kind, d, str(integrator), sub, _float("z0", z0),
+                              None if x0 is None else _float("x0", x0), _float("v0", v0))
+    return [SimResult(t=tt.copy(), **r) for r in rs]
+
+
