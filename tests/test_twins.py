@@ -8,12 +8,11 @@ from __future__ import annotations
 
 import math
 
+import lugre
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
-import lugre
 from lugre import reference as ref
 
 BACKENDS = [lugre, ref]

@@ -59,10 +59,7 @@ pub(crate) fn check_positive<T: Float>(name: &'static str, value: T) -> Result<(
     }
 }
 
-pub(crate) fn check_nonnegative<T: Float>(
-    name: &'static str,
-    value: T,
-) -> Result<(), ParamError> {
+pub(crate) fn check_nonnegative<T: Float>(name: &'static str, value: T) -> Result<(), ParamError> {
     let ok = value.is_finite() && value >= T::zero();
     if ok {
         Ok(())
@@ -376,7 +373,10 @@ mod tests {
             for _ in 0..n {
                 z = rk4_z(&p, z, v, h / n as f64);
             }
-            assert!((z - exact).abs() <= 1e-12 * (1.0 + exact.abs() * 1e6), "v={v}");
+            assert!(
+                (z - exact).abs() <= 1e-12 * (1.0 + exact.abs() * 1e6),
+                "v={v}"
+            );
         }
     }
 

@@ -3,5 +3,7 @@
 pub mod model;
 pub mod sim;
 
-pub use model::{Axis, ControlLaw, Controller, CurrentLoop, Effect, Feedforward, FeedforwardKind, Model};
+pub use model::{
+    Axis, ControlLaw, Controller, CurrentLoop, Effect, Feedforward, FeedforwardKind, Model,
+};
 pub use sim::{simulate, simulate_batch, Drive, Integrator, SimOptions, SimResult};

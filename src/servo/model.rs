@@ -452,7 +452,13 @@ impl Model {
         }
         let dm: f64 = effects
             .iter()
-            .map(|e| if let Effect::Mass { delta } = e { *delta } else { 0.0 })
+            .map(|e| {
+                if let Effect::Mass { delta } = e {
+                    *delta
+                } else {
+                    0.0
+                }
+            })
             .sum();
         if axis.mass + dm <= 0.0 {
             return Err(Error::parameter(
@@ -479,7 +485,13 @@ impl Model {
             + self
                 .effects
                 .iter()
-                .map(|e| if let Effect::Mass { delta } = e { *delta } else { 0.0 })
+                .map(|e| {
+                    if let Effect::Mass { delta } = e {
+                        *delta
+                    } else {
+                        0.0
+                    }
+                })
                 .sum::<f64>()
     }
 }
@@ -513,7 +525,13 @@ fn parse_controller(c: &Value, friction: &LugreParams<f64>) -> Result<Controller
             let kind = match get(f, "type", "controller.feedforward")?.as_str() {
                 Some("static") => FeedforwardKind::Static,
                 Some("lugre") => FeedforwardKind::Lugre,
-                Some("none") => return Ok(Controller { law, rate_hz, feedforward: None }),
+                Some("none") => {
+                    return Ok(Controller {
+                        law,
+                        rate_hz,
+                        feedforward: None,
+                    })
+                }
                 _ => {
                     return Err(Error::model(
                         "controller.feedforward.type",
@@ -569,6 +587,9 @@ mod tests {
         assert!(e.contains("axis.mass"), "{e}");
         let bad = PAPER.replace("\"effects\": []", "\"effects\": [{\"effect\": \"magic\"}]");
         let e = Model::from_json(&bad).unwrap_err().to_string();
-        assert!(e.contains("effects[0].effect") && e.contains("magic"), "{e}");
+        assert!(
+            e.contains("effects[0].effect") && e.contains("magic"),
+            "{e}"
+        );
     }
 }

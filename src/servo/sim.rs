@@ -252,7 +252,8 @@ impl Physics {
                 let ns = ((h * wc * 4.0).ceil() as usize).max(1);
                 let hs = h / ns as f64;
                 let v = s.v;
-                let d = |ia: f64, q: f64| ((kp * (ic - ia) + ki * q - r * ia - ke * v) / l, ic - ia);
+                let d =
+                    |ia: f64, q: f64| ((kp * (ic - ia) + ki * q - r * ia - ke * v) / l, ic - ia);
                 for _ in 0..ns {
                     let (a1, b1) = d(s.ia, s.q);
                     let (a2, b2) = d(s.ia + 0.5 * hs * a1, s.q + 0.5 * hs * b1);
@@ -320,13 +321,13 @@ pub fn check_inputs(model: &Model, t: &[f64], drive: &Drive, opts: &SimOptions) 
     check_len(name, a, t.len(), "t")?;
     check_finite(name, a)?;
     if opts.substeps == 0 {
-        return Err(Error::parameter(
-            "substeps",
-            0.0,
-            "must be at least 1",
-        ));
+        return Err(Error::parameter("substeps", 0.0, "must be at least 1"));
     }
-    for (nm, val) in [("z0", opts.z0), ("v0", opts.v0), ("x0", opts.x0.unwrap_or(0.0))] {
+    for (nm, val) in [
+        ("z0", opts.z0),
+        ("v0", opts.v0),
+        ("x0", opts.x0.unwrap_or(0.0)),
+    ] {
         if !val.is_finite() {
             return Err(Error::parameter(nm, val, "must be finite"));
         }
@@ -430,9 +431,9 @@ pub fn simulate(
         q: 0.0,
         fl: 0.0,
     };
-    let mut ff = ctrl.and_then(|c| c.feedforward.as_ref()).map(|f| {
-        (f.kind, f.friction, Compensator::new(f.friction))
-    });
+    let mut ff = ctrl
+        .and_then(|c| c.feedforward.as_ref())
+        .map(|f| (f.kind, f.friction, Compensator::new(f.friction)));
     let mut out = SimResult {
         x: Vec::with_capacity(n_out),
         v: Vec::with_capacity(n_out),
@@ -513,7 +514,11 @@ pub fn simulate(
             out.x.push(s.x);
             out.v.push(s.v);
             out.z.push(s.z);
-            out.i.push(if phys.current_loop.is_some() { s.ia } else { ic });
+            out.i.push(if phys.current_loop.is_some() {
+                s.ia
+            } else {
+                ic
+            });
             out.friction.push(f);
             let fm = phys.kf
                 * if phys.current_loop.is_some() {
