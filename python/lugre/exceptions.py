@@ -23,6 +23,8 @@ a group, for example ``warnings.simplefilter("error", lugre.exceptions.LugreWarn
 
 from __future__ import annotations
 
+import math
+from decimal import Decimal
 from typing import Any
 
 __all__ = [
@@ -38,6 +40,22 @@ __all__ = [
     "PassivityWarning",
     "UnitsWarning",
 ]
+
+
+def _fmt_f64(x: Any) -> str:
+    """Format a number as Rust's ``Display`` for ``f64`` does (``0``, ``-0.01``, ``NaN``,
+    ``inf``, ``0.0000001``), so that messages match the core's; other values by ``str``."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        return str(x)
+    x = float(x)
+    if math.isnan(x):
+        return "NaN"
+    if math.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    s = repr(x)
+    if "e" in s or "E" in s:
+        s = format(Decimal(s), "f")
+    return s.removesuffix(".0")
 
 
 class LugreError(Exception):
@@ -116,7 +134,7 @@ class ParameterError(_Detailed, ValueError):
         ParameterError
         """
         return cls(
-            f"parameter {name} = {value} is invalid: it {requirement}",
+            f"parameter {name} = {_fmt_f64(value)} is invalid: it {requirement}",
             name=name,
             value=value,
             requirement=requirement,

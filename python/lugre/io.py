@@ -35,7 +35,7 @@ from typing import Any, Union
 
 import numpy as np
 
-from .exceptions import FileFormatError, InputError
+from .exceptions import FileFormatError, InputError, _fmt_f64
 
 __all__ = ["COLUMNS", "Recording", "read_recording", "write_recording"]
 
@@ -192,15 +192,17 @@ class Recording:
                 k = int(bad[0])
                 raise InputError.at(
                     name,
-                    f"element {k} is {a[k]} : remove or interpolate non-finite samples",
+                    f"element {k} is {_fmt_f64(a[k])} : remove or interpolate non-finite "
+                    "samples",
                 )
         bad = np.flatnonzero(np.diff(self.t) <= 0.0)
         if bad.size:
             k = int(bad[0]) + 1
             raise InputError.at(
                 "t",
-                f"time is not strictly increasing at element {k} ({self.t[k]} after "
-                f"{self.t[k - 1]}): sort the record and drop repeated samples",
+                f"time is not strictly increasing at element {k} ({_fmt_f64(self.t[k])} "
+                f"after {_fmt_f64(self.t[k - 1])}): sort the record and drop repeated "
+                "samples",
             )
         self.meta = dict(self.meta)
 

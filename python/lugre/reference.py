@@ -26,7 +26,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ._result import SimResult
-from .exceptions import DataError, InputError, ModelError, ParameterError
+from .exceptions import DataError, InputError, ModelError, ParameterError, _fmt_f64
 from .model import ModelLike, _as_model, _CurrentLoop, _Friction, _Parsed, _StaticSet
 
 __all__ = ["SimResult", "friction_force", "simulate", "stribeck"]
@@ -55,7 +55,7 @@ def _check_finite(name: str, a: list[float]) -> None:
     for k, x in enumerate(a):
         if not math.isfinite(x):
             raise InputError.at(
-                name, f"element {k} is {x} : remove or interpolate non-finite samples"
+                name, f"element {k} is {_fmt_f64(x)} : remove or interpolate non-finite samples"
             )
 
 
@@ -67,8 +67,9 @@ def _check_time(name: str, t: list[float]) -> None:
         if t[k + 1] <= t[k]:
             raise InputError.at(
                 name,
-                f"time is not strictly increasing at element {k + 1} ({t[k + 1]} after "
-                f"{t[k]}): sort the record and drop repeated samples",
+                f"time is not strictly increasing at element {k + 1} "
+                f"({_fmt_f64(t[k + 1])} after {_fmt_f64(t[k])}): sort the record and "
+                "drop repeated samples",
             )
 
 
@@ -644,7 +645,7 @@ def simulate(
             step(s, ic_eff, h, tj)
         if not (math.isfinite(s.x) and math.isfinite(s.v) and math.isfinite(s.z)):
             raise DataError(
-                f"data: the simulation diverged at t = {time}: check the controller gains "
+                f"data: the simulation diverged at t = {_fmt_f64(time)}: check the controller gains "
                 "against the mass and the control rate"
             )
         time = nxt
