@@ -213,20 +213,23 @@ def friction_force(
     p = _as_model(model)._parsed.friction
     vv = _array("v", v).tolist()
     _check_finite("v", vv)
-    dta = np.asarray(dt, dtype=float)
-    if dta.ndim == 0 or dta.size == 1:
-        dts = [float(dta.reshape(-1)[0])] if dta.size else []
-        scalar = True
-    else:
-        dts = _array("dt", dta).tolist()
-        _check_len("dt", dts, len(vv), "v")
-        scalar = False
+    try:
+        dta = np.asarray(dt, dtype=float).reshape(-1)
+    except (TypeError, ValueError) as e:
+        raise InputError.at("dt", f"must be a number or an array of numbers ({e})") from None
+    # the same checks in the same order as the core's binding
     if dta.size == 0:
         raise InputError.at("dt", "is empty: give the hold interval [s]")
+    dts = dta.tolist()
+    scalar = len(dts) == 1
+    if not scalar:
+        _check_len("dt", dts, len(vv), "v")
     _check_finite("dt", dts)
     for k, h in enumerate(dts):
         if h < 0.0:
-            raise InputError.at("dt", f"element {k} is {h}: hold intervals must be >= 0")
+            raise InputError.at(
+                "dt", f"element {k} is {_fmt_f64(h)}: hold intervals must be >= 0"
+            )
     z = _finite_option("z0", z0)
     n = len(vv)
     out = [0.0] * n
