@@ -106,7 +106,7 @@ class ParameterError(_Detailed, ValueError):
     --------
     >>> e = ParameterError.invalid("axis.mass", 0.0, "must be greater than zero")
     >>> str(e)
-    'parameter axis.mass = 0.0 is invalid: it must be greater than zero'
+    'parameter axis.mass = 0 is invalid: it must be greater than zero'
     >>> isinstance(e, ValueError), e.name
     (True, 'axis.mass')
     """
