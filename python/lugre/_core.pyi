@@ -4,13 +4,13 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "__version__",
     "check_model",
-    "stribeck",
     "friction_force",
+    "num_threads",
     "simulate",
     "simulate_batch",
-    "num_threads",
-    "__version__",
+    "stribeck",
 ]
 
 __version__: str

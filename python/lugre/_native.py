@@ -16,6 +16,7 @@ from . import _core
 from ._result import SimResult
 from .exceptions import InputError
 from .model import ModelLike, _as_model
+from .reference import _check_substeps_type, _select_drive
 
 __all__ = ["friction_force", "simulate", "simulate_batch", "stribeck"]
 
@@ -114,15 +115,8 @@ def _float(name: str, value: Any) -> float:
 
 
 def _drive(x_ref: Any, v_ref: Any, current: Any) -> tuple[str, np.ndarray]:
-    given = [(k, a) for k, a in (("x_ref", x_ref), ("v_ref", v_ref), ("current", current))
-             if a is not None]
-    if len(given) != 1:
-        raise InputError.at(
-            "x_ref",
-            "give exactly one of x_ref (pid), v_ref (pi_speed) or current (open loop)",
-        )
-    name, a = given[0]
-    return name, _array(name, a)
+    kind, a = _select_drive(x_ref, v_ref, current)
+    return kind, _array(kind, a)
 
 
 def simulate(
@@ -173,15 +167,9 @@ def simulate(
 
 
 def _substeps(substeps: Any) -> int:
-    from .exceptions import ParameterError
-
-    try:
-        sub = int(substeps)
-    except (TypeError, ValueError):
-        raise ParameterError.invalid("substeps", substeps, "must be a whole number >= 1") from None
-    if sub < 1 or sub != substeps:
-        raise ParameterError.invalid("substeps", substeps, "must be a whole number >= 1")
-    return sub
+    """Integer check as in the reference; the core checks the range (>= 1)."""
+    _check_substeps_type(substeps)
+    return max(int(substeps), 0)
 
 
 def simulate_batch(

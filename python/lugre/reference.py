@@ -90,6 +90,31 @@ def _finite_option(name: str, value: Any) -> float:
     return x
 
 
+def _check_substeps_type(substeps: Any) -> None:
+    """``substeps`` must be an integer (its range is checked with the other inputs)."""
+    if isinstance(substeps, bool) or not isinstance(substeps, Integral):
+        raise TypeError(f"substeps must be an integer, got {type(substeps).__name__}")
+
+
+def _select_drive(x_ref: Any, v_ref: Any, current: Any) -> tuple[str, Any]:
+    """The one drive given: ``("x_ref" | "v_ref" | "current", array_like)``."""
+    drives = [(k, a) for k, a in (("x_ref", x_ref), ("v_ref", v_ref), ("current", current))
+              if a is not None]
+    if not drives:
+        raise InputError.at(
+            "x_ref",
+            "nothing drives the axis: give a position reference x_ref, a speed reference "
+            "v_ref, or an open-loop current",
+        )
+    if len(drives) > 1:
+        raise InputError.at(
+            drives[1][0],
+            f"give only one of x_ref, v_ref and current (got {drives[0][0]} and "
+            f"{drives[1][0]})",
+        )
+    return drives[0]
+
+
 # --------------------------------------------------------------------------------------
 # Friction (src/friction/mod.rs)
 # --------------------------------------------------------------------------------------
@@ -486,23 +511,8 @@ def simulate(
         raise InputError.at(
             "integrator", f'unknown integrator "{integrator}": use "exact" or "rk4"'
         )
-    if isinstance(substeps, bool) or not isinstance(substeps, Integral):
-        raise TypeError(f"substeps must be an integer, got {type(substeps).__name__}")
-    drives = [(k, a) for k, a in (("x_ref", x_ref), ("v_ref", v_ref), ("current", current))
-              if a is not None]
-    if not drives:
-        raise InputError.at(
-            "x_ref",
-            "nothing drives the axis: give a position reference x_ref, a speed reference "
-            "v_ref, or an open-loop current",
-        )
-    if len(drives) > 1:
-        raise InputError.at(
-            drives[1][0],
-            f"give only one of x_ref, v_ref and current (got {drives[0][0]} and "
-            f"{drives[1][0]})",
-        )
-    kind, drive_in = drives[0]
+    _check_substeps_type(substeps)
+    kind, drive_in = _select_drive(x_ref, v_ref, current)
     ta = _array("t", t)
     tl = ta.tolist()
     ref = _array(kind, drive_in).tolist()
