@@ -37,7 +37,7 @@ pub struct DynamicFitOptions {
     pub sigma0_start: Option<f64>,
     /// Start value of sigma1 (default: the model's).
     pub sigma1_start: Option<f64>,
-    /// Evaluate a coarse grid (a factor 10 either side of the start) first.
+    /// Evaluate a coarse grid (5 x 3 nodes, a factor 10 either side of the start) first.
     pub grid: bool,
     /// Maximum IRLS (outer) iterations.
     pub max_iter: usize,
@@ -64,7 +64,7 @@ impl Default for DynamicFitOptions {
             sigma1_start: None,
             grid: true,
             max_iter: 20,
-            tol: 1e-4,
+            tol: 1e-3,
             max_evals: 200,
             scale_floor: 0.0,
             sigma2_rel_uncertainty: 0.01,
@@ -251,11 +251,11 @@ pub fn fit_dynamic(
     let mut step = vec![0.2, 0.5];
     if opts.grid {
         let mut nodes = Vec::new();
-        for i in 0..7 {
-            for j in 0..5 {
+        for i in 0..5 {
+            for j in 0..3 {
                 nodes.push([
-                    theta0[0] + ln10 * (i as f64 - 3.0) / 3.0,
-                    theta0[1] + ln10 * (j as f64 - 2.0) / 2.0,
+                    theta0[0] + ln10 * (i as f64 - 2.0) / 2.0,
+                    theta0[1] + ln10 * (j as f64 - 1.0),
                 ]);
             }
         }
@@ -273,7 +273,7 @@ pub fn fit_dynamic(
             .min_by(|&a, &b| scores[a].total_cmp(&scores[b]))
         {
             theta0 = nodes[k].to_vec();
-            step = vec![ln10 / 6.0, ln10 / 4.0];
+            step = vec![ln10 / 4.0, ln10 / 2.0];
         }
     }
     let setup = IrlsSetup {
@@ -284,7 +284,7 @@ pub fn fit_dynamic(
         nm: NmOptions {
             max_evals: opts.max_evals,
             xtol: opts.tol.max(1e-8),
-            ftol: 1e-10,
+            ftol: 1e-6,
             restarts: 1,
         },
         step: &step,

@@ -1,9 +1,10 @@
 //! The outer IRLS loop shared by the static and dynamic estimators.
 //!
 //! Outer iteration: residuals at the current parameters, robust scale, weights; inner:
-//! Nelder-Mead on the weighted objective. Stops when the weights no longer change (by
-//! more than 1e-3) or the parameters move by less than `tol` (the estimators work in
-//! log-parameters, so this is a relative change).
+//! Nelder-Mead on the weighted objective. Stops when the weights no longer change (none
+//! by more than 1e-3, or 1e-5 on average for long records) or the parameters move by
+//! less than `tol` (the estimators work in log-parameters, so this is a relative
+//! change).
 
 use super::nelder_mead::{minimize, NmOptions};
 use super::robust::{robust_scale, Weighting};
@@ -68,14 +69,20 @@ pub(crate) fn irls(
             .zip(&w)
             .map(|(a, b)| (a - b).abs())
             .fold(0.0f64, f64::max);
+        let dw_mean = w_new
+            .iter()
+            .zip(&w)
+            .map(|(a, b)| (a - b).abs())
+            .sum::<f64>()
+            / w.len().max(1) as f64;
         w = w_new;
-        if dw <= 1e-3 || dtheta <= setup.tol {
+        if dw <= 1e-3 || dw_mean <= 1e-5 || dtheta <= setup.tol {
             converged = true;
             break;
         }
         // later rounds start close to the answer: a smaller simplex saves evaluations
         for (sk, s0) in step.iter_mut().zip(setup.step) {
-            *sk = (dtheta * 2.0).clamp(s0 * 0.02, *s0);
+            *sk = s0 * 0.1;
         }
     }
     Some(IrlsOutcome {
