@@ -231,6 +231,23 @@ fn fit_direction(
         },
         step: &step,
     };
+    // Redescending weights (IGG, Tukey) can settle on a wrong set of rejected points
+    // when started far out; a Huber pass first (monotone, unique fixed point) gives
+    // them a start near the answer, as in MM-estimation (Yohai 1987).
+    let theta0 = if matches!(
+        opts.weighting,
+        Weighting::Igg { .. } | Weighting::Tukey { .. }
+    ) {
+        let pre = IrlsSetup {
+            weighting: Weighting::huber(),
+            ..setup
+        };
+        irls(&resid, &objective, theta0.clone(), &pre)
+            .map(|o| o.theta)
+            .unwrap_or(theta0)
+    } else {
+        theta0
+    };
     let out = irls(&resid, &objective, theta0, &setup).ok_or_else(|| {
         Error::Data(format!(
             "{label} direction: the Stribeck curve could not be evaluated at the start values; check the data for extreme values"
