@@ -1,0 +1,201 @@
+"""The result of a diagnosis: findings, fit figures, residuals; REPORT.json and a summary."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..model import Model
+
+__all__ = ["Diagnosis", "Finding"]
+
+
+@dataclass
+class Finding:
+    """One effect the model left out.
+
+    Attributes
+    ----------
+    effect : str
+        Vocabulary name (``cogging``, ``offset``, ...).
+    parameters : dict
+        The effect's parameters (CONTRACT form, without ``"effect"``).
+    where : dict
+        ``position``, ``time``, ``velocity``: ``[lo, hi]`` or ``None`` (not confined).
+    explained : float
+        Share of the residual variance (of the model as given) it accounts for.
+    evidence : str
+        One or two sentences a person can check.
+    alternatives : list of dict
+        Explanations that fit equally well, with the experiment that separates them.
+    """
+
+    effect: str
+    parameters: dict[str, Any]
+    where: dict[str, Any]
+    explained: float
+    evidence: str
+    alternatives: list[dict[str, Any]] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The CONTRACT form (plus ``alternatives`` when there are any)."""
+        d: dict[str, Any] = {
+            "effect": self.effect,
+            "parameters": _plain(self.parameters),
+            "where": _plain(self.where),
+            "explained": round(float(self.explained), 4),
+            "evidence": self.evidence,
+        }
+        if self.alternatives:
+            d["alternatives"] = _plain(self.alternatives)
+        return d
+
+
+def _plain(o: Any) -> Any:
+    if isinstance(o, dict):
+        return {str(k): _plain(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_plain(v) for v in o]
+    if isinstance(o, (np.floating, float)):
+        f = float(o)
+        return f if math.isfinite(f) else None
+    if isinstance(o, (np.integer,)):
+        return int(o)
+    if isinstance(o, np.ndarray):
+        return _plain(o.tolist())
+    return o
+
+
+@dataclass
+class Diagnosis:
+    """What :func:`lugre.diagnose.diagnose` found.
+
+    Attributes
+    ----------
+    findings : list of Finding
+        Most important first; empty when nothing beyond noise was found.
+    fit : dict
+        ``before``/``after`` (and ``holdout_before``/``holdout_after`` when a hold-out
+        recording was given, ``closed_loop`` when the controller is known, ``held_out``
+        for the held-out blocks of the recording itself): ``rms_force`` [N] and
+        ``nrmse_force``.
+    model : Model
+        The model as given.
+    augmented : Model
+        With the findings added and the base parameters re-estimated.
+    base : dict
+        Per base parameter: ``before``, ``after``, ``change`` (relative), ``tolerance``.
+    noise : dict
+        Noise floor: ``rms`` [N], ``n_eff``, ``bandwidth_hz``.
+    located : dict
+        Where the residual rises above the noise floor, before and after.
+    unexplained : dict or None
+        Set when the residual stays clearly above noise and no effect explains it.
+    notes : list of str
+        Further remarks (poorly determined parameters, ambiguities).
+    trials : list of dict
+        Every candidate tried, with its held-out evidence.
+    data : dict
+        Arrays for plots: ``t``, ``x``, ``v``, ``before``, ``after``, ``force``, and the
+        position spectrum of the residual ``spectrum_k``/``spectrum_p``.
+    """
+
+    findings: list[Finding]
+    fit: dict[str, Any]
+    model: Model
+    augmented: Model
+    base: dict[str, dict[str, float]]
+    noise: dict[str, float]
+    located: dict[str, Any]
+    unexplained: dict[str, Any] | None = None
+    notes: list[str] = field(default_factory=list)
+    trials: list[dict[str, Any]] = field(default_factory=list)
+    data: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
+    timing: float = 0.0
+
+    def augmented_model(self) -> Model:
+        """The model with the findings added to ``effects`` and the base re-estimated."""
+        return self.augmented
+
+    def to_dict(self) -> dict[str, Any]:
+        """REPORT.json (CONTRACT shape, plus ``noise``, ``base``, ``located``, ...)."""
+        d: dict[str, Any] = {
+            "findings": [f.to_dict() for f in self.findings],
+            "fit": _plain(self.fit),
+            "noise": _plain(self.noise),
+            "base": _plain(self.base),
+            "located": _plain(self.located),
+            "unexplained": _plain(self.unexplained),
+            "notes": list(self.notes),
+            "trials": [
+                {k: _plain(v) for k, v in t.items() if k in (
+                    "step", "effect", "gain", "p", "positive", "contrib", "accepted", "why")}
+                for t in self.trials
+            ],
+        }
+        return d
+
+    def to_json(self, indent: int | None = 2) -> str:
+        """:meth:`to_dict` as JSON text."""
+        return json.dumps(self.to_dict(), indent=indent)
+
+    def summary(self) -> str:
+        """A plain-text report for a control engineer."""
+        lines: list[str] = []
+        fb, fa = self.fit["before"], self.fit["after"]
+        lines.append(
+            f"Noise floor {self.noise['rms']:.3g} N rms (n_eff {self.noise['n_eff']:.0f}). "
+            f"Force residual {fb['rms_force']:.3g} N -> {fa['rms_force']:.3g} N "
+            f"(nrmse {100 * fb['nrmse_force']:.2f} % -> {100 * fa['nrmse_force']:.2f} %)."
+        )
+        if self.fit.get("holdout_before"):
+            hb, ha = self.fit["holdout_before"], self.fit["holdout_after"]
+            lines.append(
+                f"Hold-out: {hb['rms_force']:.3g} N -> {ha['rms_force']:.3g} N "
+                f"(nrmse {100 * hb['nrmse_force']:.2f} % -> {100 * ha['nrmse_force']:.2f} %)."
+            )
+        if "closed_loop" in self.fit:
+            cl = self.fit["closed_loop"]
+            lines.append(
+                "Closed loop (simulated under the controller vs measured): position "
+                f"{cl['before']['rms_position'] * 1e6:.3g} um -> "
+                f"{cl['after']['rms_position'] * 1e6:.3g} um rms, current "
+                f"{cl['before']['rms_current']:.3g} A -> {cl['after']['rms_current']:.3g} A rms."
+            )
+        if not self.findings:
+            lines.append("Findings: none beyond noise.")
+        for k, f in enumerate(self.findings, 1):
+            ps = ", ".join(
+                f"{a}={_fmt(v)}" for a, v in f.parameters.items()
+                if a not in ("positions", "scale")
+            )
+            wh = ", ".join(f"{a} {_fmt(v)}" for a, v in f.where.items() if v is not None)
+            lines.append(f"{k}. {f.effect} ({ps}) explains {100 * f.explained:.0f} % of "
+                         f"the residual{'; lives at ' + wh if wh else ''}.")
+            lines.append(f"   {f.evidence}")
+            for alt in f.alternatives:
+                lines.append(f"   Equally well: {alt['effect']} {_fmt(alt['parameters'])}. "
+                             f"To separate: {alt['experiment']}")
+        moved = [f"{n} {100 * b['change']:+.1f} %" for n, b in self.base.items()
+                 if abs(b["change"]) > 0.005]
+        if moved:
+            lines.append("Base parameters re-estimated: " + ", ".join(moved) + ".")
+        if self.unexplained:
+            u = self.unexplained
+            lines.append(f"Unexplained: {u['message']}")
+        lines.extend(self.notes)
+        return "\n".join(lines)
+
+
+def _fmt(v: Any) -> str:
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_fmt(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{k}: {_fmt(x)}" for k, x in v.items()) + "}"
+    return str(v)
