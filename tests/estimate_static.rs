@@ -120,8 +120,8 @@ fn paper_axis_points_igg() {
     assert!(fit.positive.converged && fit.negative.converged);
     // the intervals contain the truth
     for (d, tr) in [(&fit.positive, &t.pos), (&fit.negative, &t.neg)] {
-        for k in 0..4 {
-            assert!(d.ci_low[k] <= tr[k] && tr[k] <= d.ci_high[k], "{k}: {d:?}");
+        for (k, x) in tr.iter().enumerate() {
+            assert!(d.ci_low[k] <= *x && *x <= d.ci_high[k], "{k}: {d:?}");
         }
     }
 }

@@ -221,7 +221,7 @@ pub fn quantile(a: &[f64], q: f64) -> f64 {
 ///
 /// ```
 /// use lugre::estimate::robust_scale;
-/// let e = [-1.0, 1.0, -1.0, 1.0, 100.0];
+/// let e = [-1.0, 0.0, 1.0, 0.0, 100.0];
 /// assert!((robust_scale(&e) - 1.4826).abs() < 1e-12);
 /// ```
 pub fn robust_scale(e: &[f64]) -> f64 {
