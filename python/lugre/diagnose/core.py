@@ -179,42 +179,58 @@ def _split(beta: np.ndarray, q: int, terms: list[Term]) -> tuple[np.ndarray, lis
 def _refine(model: Model, sig: R.Signals, terms: list[Term], base: dict[str, float],
             betas: list[np.ndarray], s2: float, iters: int = 3
             ) -> tuple[Model, dict[str, float], list[np.ndarray], E.Context]:
-    """Gauss-Newton on base parameters and effect coefficients jointly (exact residual)."""
+    """Damped Gauss-Newton on base parameters and effect coefficients (exact residual).
+
+    Each step solves the linearised joint problem (base prior centred on the model as
+    given) and is halved until the exact residual decreases.
+    """
     given = list(model.effects)
     theta0 = {n: E.get_base(model, n) for n, _ in E.BASE_PARAMS}
     tolrel = dict(E.BASE_PARAMS)
-    ctx = E.Context.build(sig, model)
-    for _ in range(iters):
+
+    def build(base: dict[str, float], betas: list[np.ndarray]) -> tuple[Any, ...]:
+        base = dict(base)
+        betas = [b.copy() for b in betas]
         bm = E.apply_base(model, base)
-        ctx = E.Context.build(sig, bm)
-        for k, t in enumerate(terms):  # keep the friction level in the base parameters
+        for k, t in enumerate(terms):  # keep the overall friction level in the base
             if t.effect == "position_friction":
-                s = 1.0 + betas[k]
-                c = float(np.median(s))
-                betas[k] = s / c - 1.0
+                sc = 1.0 + betas[k]
+                c = float(np.median(sc))
+                betas[k] = sc / c - 1.0
                 for side in ("positive", "negative"):
                     for key in ("fc", "fs"):
                         base[f"{side}.{key}"] = E.get_base(bm, f"{side}.{key}") * c
                 bm = E.apply_base(model, base)
-                ctx = E.Context.build(sig, bm)
+        ctx = E.Context.build(sig, bm)
         aug = bm.replace(effects=given + _effects_of(terms, betas, ctx))
-        r = R.residual(aug, sig)
-        J, names, th, _ = E.base_jacobian(aug, sig)
-        tol = np.array([tolrel[n] * max(abs(theta0[n]), 1e-12) for n in names])
-        center = np.array([theta0[n] - E.get_base(aug, n) for n in names])
-        new_terms = [Term(cand=t.cand, h=t.h, X=t.cand.columns(t.h, ctx), prior=t.prior)
-                     for t in terms]
-        sc = Scorer(r, J, tol, sig.mask, s2, blocks=2, center=center)
-        ev = sc.evaluate(new_terms)
-        d, dbs = _split(ev.beta, len(names), new_terms)
         base = {n: E.get_base(aug, n) for n, _ in E.BASE_PARAMS}
-        for n, dv in zip(names, d):
-            base[n] = base[n] + dv
-        betas = [b + db for b, db in zip(betas, dbs)]
-        terms = new_terms
-    bm = E.apply_base(model, base)
-    ctx = E.Context.build(sig, bm)
-    aug = bm.replace(effects=given + _effects_of(terms, betas, ctx))
+        r = R.residual(aug, sig)
+        return float(np.sum(r[sig.mask] ** 2)), aug, base, betas, ctx, r
+
+    sse, aug, base, betas, ctx, r = build(base, betas)
+    for _ in range(iters):
+        J, names, _, _ = E.base_jacobian(aug, sig)
+        tol = np.array([tolrel[n] * max(abs(theta0[n]), 1e-12) for n in names])
+        center = np.array([theta0[n] - base[n] for n in names])
+        cur_terms = [Term(cand=t.cand, h=t.h, X=t.cand.columns(t.h, ctx), prior=t.prior)
+                     for t in terms]
+        ev = Scorer(r, J, tol, sig.mask, s2, blocks=2, center=center).evaluate(cur_terms)
+        d, dbs = _split(ev.beta, len(names), cur_terms)
+        lam = 1.0
+        improved = False
+        for _h in range(4):
+            nb = dict(base)
+            for n, dv in zip(names, d):
+                nb[n] = base[n] + lam * dv
+            nbetas = [b + lam * db for b, db in zip(betas, dbs)]
+            out = build(nb, nbetas)
+            if out[0] < sse:
+                sse, aug, base, betas, ctx, r = out
+                improved = True
+                break
+            lam *= 0.5
+        if not improved or lam < 1.0:
+            break
     return aug, base, betas, ctx
 
 
@@ -226,7 +242,7 @@ def _closed_loop(rec: Recording, before: Model, after: Model) -> dict[str, Any] 
     for key, m in (("before", before), ("after", after)):
         try:
             s = simulate(m, rec.t, rec.x_ref, x0=float(rec.x[0]))
-        except Exception as e:  # pragma: no cover - diverging models
+        except (ValueError, ArithmeticError) as e:  # pragma: no cover - diverging
             return {"error": str(e)}
         meas_i = rec.i if rec.i is not None else rec.F / m.force_constant
         out[key] = {"rms_position": float(np.sqrt(np.mean((s.x - rec.x) ** 2))),
@@ -296,7 +312,7 @@ def diagnose(
     r0 = R.residual(model, sig)
     fr0 = R.base_friction(model, sig)
     ctx = E.Context.build(sig, model, fr0)
-    J, names, th, tol = E.base_jacobian(model, sig, fr0)
+    J, names, _, tol = E.base_jacobian(model, sig, fr0)
     n_used = int(sig.mask.sum())
     noise = R.noise_floor(r0, sig)
     s2 = noise["rms"] ** 2 * n_used / noise["n_eff"]
@@ -355,9 +371,10 @@ def diagnose(
     accepted = [lg for lg in log if lg["accepted"]]
     for k, t in enumerate(terms):
         X = t.cand.columns(t.h, ctx)
-        contrib = X @ betas[k]
-        rem = r0 - contrib
-        expl = float(np.clip(1.0 - np.sum(rem[sig.mask] ** 2) / tot0, 0.0, 1.0))
+        contrib = np.einsum("ij,j->i", X, betas[k])
+        rem = r1 + contrib  # the final model without this term
+        gain_e = np.sum(rem[sig.mask] ** 2) - np.sum(r1[sig.mask] ** 2)
+        expl = float(np.clip(gain_e / tot0, 0.0, 1.0))
         effs = t.cand.to_effects(t.h, betas[k], ctx)
         e0 = effs[0]
         lg = next((g for g in accepted if g["effect"] == t.effect), accepted[min(k, len(accepted) - 1)])
@@ -438,7 +455,7 @@ def diagnose(
                 + "; ".join(f"{k} {_short(la[k])}" for k in ("time", "position", "velocity")
                             if la[k]) + "."),
         }
-    ks, pk = _position_spectrum(r1, sig)
+    _, pk = _position_spectrum(r1, sig)
     ks0, pk0 = _position_spectrum(r0, sig)
     data = {"t": sig.t, "x": sig.x, "v": sig.vf, "force": sig.fm_f, "before": r0, "after": r1,
             "mask": sig.mask, "spectrum_k": ks0, "spectrum_before": pk0, "spectrum_after": pk,
@@ -471,7 +488,8 @@ def _position_spectrum(r: np.ndarray, sig: R.Signals) -> tuple[np.ndarray, np.nd
         kk = ks[j0:j0 + 100]
         ph = 2 * np.pi * np.outer(kk, x)
         s, c = np.sin(ph), np.cos(ph)
-        out[j0:j0 + 100] = 2 * np.hypot(s @ rr, c @ rr) / x.size
+        out[j0:j0 + 100] = 2 * np.hypot(np.einsum("ij,j->i", s, rr),
+                                         np.einsum("ij,j->i", c, rr)) / x.size
     return ks, out
 
 
@@ -544,13 +562,14 @@ def fit_inverse_dynamics(
         Xm, ym = X[m], y[m]
         b = np.zeros(X.shape[1])
         for _ in range(8):
-            sw = np.sqrt(w)
-            b = np.linalg.lstsq(Xm * sw[:, None], ym * sw, rcond=None)[0]
-            e = ym - Xm @ b
+            G = np.einsum("ij,ik,i->jk", Xm, Xm, w)
+            b = np.linalg.solve(G + 1e-12 * np.trace(G) * np.eye(G.shape[0]),
+                                np.einsum("ij,i->j", Xm, w * ym))
+            e = ym - np.einsum("ij,j->i", Xm, b)
             s = 1.4826 * np.median(np.abs(e - np.median(e))) + 1e-12
             u = np.abs(e) / s
             w = np.where(u <= 1.5, 1.0, np.where(u <= 2.5, 1.5 / u, 0.0))
-        e = ym - Xm @ b
+        e = ym - np.einsum("ij,j->i", Xm, b)
         return b, float(np.sum(w * e * e))
 
     b0, sse0 = irls(design(None))

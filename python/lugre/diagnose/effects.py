@@ -299,7 +299,7 @@ class Cogging(Candidate):
         ph = 2.0 * np.pi * np.outer(ks, x)
         s, c = np.sin(ph), np.cos(ph)
         ss, cc, sc = (s * s).sum(1), (c * c).sum(1), (s * c).sum(1)
-        rs, rc = s @ r, c @ r
+        rs, rc = np.einsum("ij,j->i", s, r), np.einsum("ij,j->i", c, r)
         det = ss * cc - sc * sc
         bs = (cc * rs - sc * rc) / det
         bc = (ss * rc - sc * rs) / det

@@ -275,7 +275,7 @@ def prepare(
     v = np.where(np.abs(v) < 0.5 * q * fd, 0.0, v)
     fm_f = lowpass(fm, fc, fs)
     dfm = np.gradient(fm_f, dt)
-    edge = max(int(round(3.0 * fs / fc)), 5)
+    edge = max(round(3.0 * fs / fc), 5)
     mask = np.ones(n, dtype=bool)
     mask[:edge] = False
     mask[-edge:] = False

@@ -1,0 +1,63 @@
+"""Diagnosis on the independent mismatch datasets and on the real EMPS record."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import lugre
+import pytest
+from lugre.diagnose import diagnose, fit_inverse_dynamics
+
+SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+MISMATCH = SHARED / "datasets" / "mismatch"
+EMPS = SHARED / "datasets" / "emps" / "emps_estimation.csv"
+
+pytestmark = pytest.mark.skipif(
+    not MISMATCH.is_dir(), reason=f"shared datasets not found at {SHARED / 'datasets'}"
+)
+
+
+@pytest.mark.parametrize("case", ["none", "cogging", "position_friction"])
+def test_mismatch_case(case):
+    d = MISMATCH / case
+    truth = json.loads((d / "truth.json").read_text())["effects"]
+    dg = diagnose(lugre.read_recording(d / "recording.csv"), lugre.load_model(d / "model.json"),
+                  holdout=lugre.read_recording(d / "holdout.csv"), closed_loop=False)
+    named = [f.effect for f in dg.findings]
+    assert named == [e["effect"] for e in truth]
+    before = dg.fit["holdout_before"]["rms_force"]
+    after = dg.fit["holdout_after"]["rms_force"]
+    if truth:
+        assert after <= 0.7 * before
+    else:
+        assert after <= before * 1.001
+    for f, e in zip(dg.findings, truth):
+        if e["effect"] == "cogging":
+            assert f.parameters["pitch"] == pytest.approx(e["pitch"], rel=0.01)
+            assert f.parameters["amplitude"] == pytest.approx(e["amplitude"], rel=0.1)
+            assert f.parameters["phase"] == pytest.approx(e["phase"], abs=0.1)
+        if e["effect"] == "position_friction":
+            aug = dg.augmented_model()
+            pf = next(x for x in aug.effects if x["effect"] == "position_friction")
+            import numpy as np
+
+            xs = np.array(e["positions"])
+            s_true = np.array(e["scale"])
+            s_est = np.interp(xs, pf["positions"], pf["scale"])
+            assert np.max(np.abs(s_est - s_true)) < 0.1
+            lo, hi = f.where["position"]
+            assert lo < e["generated_as"]["center"] < hi
+
+
+@pytest.mark.skipif(not EMPS.is_file(), reason=f"EMPS record not found at {EMPS}")
+def test_emps_laps():
+    rec = lugre.read_recording(EMPS)
+    fit_part, check = rec.slice((None, 12.42)), rec.slice((12.42, None))
+    base = fit_inverse_dynamics(fit_part)
+    assert base.mass == pytest.approx(95.1, rel=0.05)
+    dg = diagnose(fit_part, base, holdout=check)
+    before = dg.fit["holdout_before"]["nrmse_force"]
+    after = dg.fit["holdout_after"]["nrmse_force"]
+    assert before < 0.0408  # per-direction LuGre base beats the symmetric benchmark model
+    assert after <= before
