@@ -25,7 +25,15 @@ from .exceptions import (
     PassivityWarning,
     UnitsWarning,
 )
-from .io import Recording, read_recording, write_recording
+from .identify import (
+    DynamicFit,
+    StaticFit,
+    SteadyStatePoints,
+    fit_dynamic,
+    fit_static,
+    steady_state_points,
+)
+from .io import Recording, read_points, read_recording, write_recording
 from .model import Model, load_model, save_model
 
 __version__ = "0.1.0"
@@ -33,6 +41,7 @@ __version__ = "0.1.0"
 __all__ = [
     "ConvergenceWarning",
     "DataError",
+    "DynamicFit",
     "FileFormatError",
     "IdentifiabilityWarning",
     "InputError",
@@ -44,13 +53,19 @@ __all__ = [
     "PassivityWarning",
     "Recording",
     "SimResult",
+    "StaticFit",
+    "SteadyStatePoints",
     "UnitsWarning",
+    "fit_dynamic",
+    "fit_static",
     "friction_force",
     "load_model",
+    "read_points",
     "read_recording",
     "save_model",
     "simulate",
     "simulate_batch",
+    "steady_state_points",
     "stribeck",
     "write_recording",
 ]

@@ -37,7 +37,14 @@ import numpy as np
 
 from .exceptions import FileFormatError, InputError, _fmt_f64
 
-__all__ = ["COLUMNS", "Recording", "read_recording", "write_recording"]
+__all__ = [
+    "COLUMNS",
+    "Recording",
+    "is_points_file",
+    "read_points",
+    "read_recording",
+    "write_recording",
+]
 
 #: Column names of a recording, in the order they are written.
 COLUMNS: tuple[str, ...] = ("t", "x", "i", "F", "v", "x_ref", "v_ref")
@@ -725,3 +732,31 @@ def write_recording(path: str | os.PathLike[str], rec: Recording) -> None:
         data = ("\n".join(lines) + "\n").encode("utf-8")
     _atomic_write(path, data)
 
+
+def is_points_file(path: str | os.PathLike[str]) -> bool:
+    """True for a CSV of steady-state points: columns ``v`` and ``F`` and no ``t``."""
+    p = os.fspath(path)
+    if not p.lower().endswith(".csv"):
+        return False
+    _, header, _ = _read_csv_table(p)
+    return "v" in header and "F" in header and "t" not in header
+
+
+def read_points(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Steady-state points ``(v [m/s], F [N])`` from a CSV with columns ``v`` and ``F``.
+
+    Raises
+    ------
+    FileFormatError
+        A column is missing or a cell is not a number (the message names the line).
+    """
+    p = os.fspath(path)
+    _, header, rows = _read_csv_table(p)
+    for name in ("v", "F"):
+        if name not in header:
+            raise FileFormatError(
+                f"{p}: no column {name!r} (found {', '.join(header)}): steady-state points "
+                "need columns 'v' [m/s] and 'F' [N]",
+                path=p, column=name,
+            )
+    return _csv_column(p, header, rows, "v"), _csv_column(p, header, rows, "F")

@@ -55,3 +55,46 @@ def label_axes(axes: Sequence[Any], ylabels: Sequence[str], xlabel: str) -> None
         ax.set_ylabel(yl)
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel(xlabel)
+
+
+def static_fit_figure(v: Any, F: Any, fit: Any, path: str | os.PathLike[str]) -> str:
+    """Steady-state points, rejected points and the fitted Stribeck curves, per direction.
+
+    Returns
+    -------
+    str
+        The path written.
+    """
+    import numpy as np
+
+    from .model import Model
+
+    v, F = np.asarray(v, float), np.asarray(F, float)
+    fig, axes = figure(1, 2, figsize=(10, 4))
+    rejected = np.zeros(len(v), bool)
+    rejected[fit.rejected] = True
+    for ax, sign, d, name in ((axes[0, 0], 1, fit.positive, "v > 0"),
+                              (axes[0, 1], -1, fit.negative, "v < 0")):
+        sel = np.sign(v) == sign
+        a = np.abs(v[sel])
+        ax.semilogx(a, sign * F[sel], "o", ms=4, label="points")
+        ax.semilogx(np.abs(v[sel & rejected]), sign * F[sel & rejected], "x", ms=9, mew=2,
+                    color="C3", label="rejected (gross error)")
+        grid = np.geomspace(max(a.min(), 1e-6), a.max(), 300)
+        m = Model.paper().with_friction(positive=d.params, negative=d.params)
+        curve = np.abs(_stribeck(sign * grid, m))
+        ax.semilogx(grid, curve, "k-", lw=1, label="fit")
+        p = d.params
+        ax.set_title(f"{name}: fc {p['fc']:.2f} N, fs {p['fs']:.2f} N, "
+                     f"sigma2 {p['sigma2']:.1f} N s/m, vs {1e3 * p['vs']:.2f} mm/s", fontsize=9)
+        ax.set_xlabel("|v| [m/s]")
+        ax.set_ylabel("|F| [N]")
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=8)
+    return save_png(fig, path)
+
+
+def _stribeck(v: Any, m: Any) -> Any:
+    from ._native import stribeck
+
+    return stribeck(v, m)

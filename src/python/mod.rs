@@ -9,6 +9,8 @@ use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+mod estimate;
+
 /// Map a core error onto the package's exception classes (`lugre.exceptions`).
 pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
     let class = match &e {
@@ -38,12 +40,12 @@ pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
 
 type ArrayPair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 
-fn slice<'a>(name: &str, a: &'a PyReadonlyArray1<'_, f64>) -> Result<&'a [f64], Error> {
+pub(crate) fn slice<'a>(name: &str, a: &'a PyReadonlyArray1<'_, f64>) -> Result<&'a [f64], Error> {
     a.as_slice()
         .map_err(|_| Error::input(name, "must be a contiguous 1-D float64 array"))
 }
 
-fn parse_model(py: Python<'_>, text: &str) -> PyResult<Model> {
+pub(crate) fn parse_model(py: Python<'_>, text: &str) -> PyResult<Model> {
     Model::from_json(text).map_err(|e| to_py(py, e))
 }
 
@@ -248,6 +250,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_batch, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(estimate::fit_static_points, m)?)?;
+    m.add_function(wrap_pyfunction!(estimate::plateaus, m)?)?;
+    m.add_function(wrap_pyfunction!(estimate::fit_dynamic_record, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

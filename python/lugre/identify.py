@@ -1,0 +1,357 @@
+"""Robust friction identification, the two steps of the seed paper, on the Rust core.
+
+1. :func:`fit_static`: Stribeck parameters ``(fc, fs, sigma2, vs)`` of each direction from
+   steady-state points, which :func:`steady_state_points` extracts from a raw record of
+   constant-velocity plateaus.
+2. :func:`fit_dynamic`: the bristle parameters ``sigma0`` and ``sigma1`` from a
+   closed-loop position record, the static sets held, by simulating the model's
+   controller; with confidence intervals and a verdict on what the record determines.
+
+Both are iteratively reweighted least squares (IGG weights by default; Huber, Tukey or
+none) with Nelder-Mead inside, as in the paper, with standard errors at the optimum.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from . import _core
+from ._native import _array
+from .exceptions import ConvergenceWarning, IdentifiabilityWarning, InputError
+from .io import Recording, read_recording
+from .model import Model, ModelLike, _as_model
+
+__all__ = [
+    "DirectionFit",
+    "DynamicFit",
+    "StaticFit",
+    "SteadyStatePoints",
+    "fit_dynamic",
+    "fit_static",
+    "steady_state_points",
+]
+
+STATIC_NAMES = ("fc", "fs", "sigma2", "vs")
+
+
+@dataclass
+class DirectionFit:
+    """Stribeck fit of one direction (all parameters positive, also for ``v < 0``)."""
+
+    params: dict[str, float]
+    """``fc`` [N], ``fs`` [N], ``sigma2`` [N s/m], ``vs`` [m/s]."""
+    std_err: dict[str, float]
+    """Standard errors (NaN where they cannot be computed)."""
+    ci95: dict[str, tuple[float, float]]
+    """95 % confidence intervals."""
+    indices: np.ndarray
+    """Indices of this direction's points in the input."""
+    weights: np.ndarray
+    """Final IRLS weight of each of these points (0: rejected as a gross error)."""
+    residuals: np.ndarray
+    """``F - F_model`` at each of these points [N]."""
+    scale: float
+    """Robust residual scale (1.4826 MAD) [N]."""
+    iterations: int
+    converged: bool
+
+    @classmethod
+    def _from_core(cls, d: dict[str, Any]) -> DirectionFit:
+        return cls(
+            params={k: float(d[k]) for k in STATIC_NAMES},
+            std_err=dict(zip(STATIC_NAMES, map(float, d["std_err"]))),
+            ci95={k: (float(lo), float(hi))
+                  for k, lo, hi in zip(STATIC_NAMES, d["ci_low"], d["ci_high"])},
+            indices=np.asarray(d["indices"], dtype=np.intp),
+            weights=d["weights"],
+            residuals=d["residuals"],
+            scale=float(d["scale"]),
+            iterations=int(d["iterations"]),
+            converged=bool(d["converged"]),
+        )
+
+
+@dataclass
+class StaticFit:
+    """Result of :func:`fit_static`."""
+
+    positive: DirectionFit
+    negative: DirectionFit
+    weights: np.ndarray
+    """Final weight of every input point (0 for rejected and zero-speed points)."""
+    rejected: list[int]
+    """Indices of the points rejected as gross errors."""
+    n_zero_speed: int
+    weighting: str
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def converged(self) -> bool:
+        """True when both directions converged."""
+        return self.positive.converged and self.negative.converged
+
+    def to_model(self, base: ModelLike | None = None, **axis: float) -> Model:
+        """A model with these static sets.
+
+        Parameters
+        ----------
+        base : Model, dict or path, optional
+            Supplies the axis, sigma0, sigma1, effects and controller. Without it the
+            paper's axis values are used for what the static step cannot tell, and the
+            model is marked ``"identified": {"static": true, "dynamic": false}``.
+        **axis
+            ``mass=``, ``force_constant=`` override the axis.
+        """
+        d = (_as_model(base) if base is not None else Model.paper()).to_dict()
+        d["friction"]["positive"] = dict(self.positive.params)
+        d["friction"]["negative"] = dict(self.negative.params)
+        d["axis"].update({k: float(v) for k, v in axis.items()})
+        if base is None:
+            d.pop("controller", None)
+            d["identified"] = {"static": True, "dynamic": False}
+        return Model.from_dict(d)
+
+    def summary(self, truth: dict[str, dict[str, float]] | None = None) -> str:
+        """A table a person reads: estimates, 95 % intervals, and errors against ``truth``
+        (``{"positive": {...}, "negative": {...}}``) when given."""
+        lines = [f"static fit ({self.weighting} weights): {len(self.rejected)} points "
+                 f"rejected as gross errors {self.rejected}"]
+        for name, d in (("v > 0", self.positive), ("v < 0", self.negative)):
+            lines.append(f"  {name}  (IRLS iterations {d.iterations}, "
+                         f"{'converged' if d.converged else 'NOT converged'}, "
+                         f"residual scale {d.scale:.3g} N)")
+            for k in STATIC_NAMES:
+                lo, hi = d.ci95[k]
+                row = f"    {k:7s} {d.params[k]:12.6g}   95 % CI [{lo:.6g}, {hi:.6g}]"
+                if truth is not None:
+                    key = "positive" if d is self.positive else "negative"
+                    tv = truth[key][k]
+                    row += f"   truth {tv:.6g}  error {100 * (d.params[k] - tv) / tv:+.2f} %"
+                lines.append(row)
+        lines += [f"  note: {n}" for n in self.notes]
+        return "\n".join(lines)
+
+
+def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
+               scale_floor: float = 0.0) -> StaticFit:
+    """Robust Stribeck fit of steady-state points, per direction.
+
+    Parameters
+    ----------
+    v : array_like
+        Constant velocities [m/s]; zero speeds are ignored (and counted).
+    F : array_like
+        Steady-state forces [N] (negative for ``v < 0``).
+    weighting : {"igg", "huber", "tukey", "none"}
+        Robust weight function; ``"none"`` is plain least squares.
+    max_iter : int
+        IRLS iterations at most.
+    scale_floor : float
+        Lower bound of the residual scale [N] (e.g. the force resolution).
+
+    Returns
+    -------
+    StaticFit
+
+    Raises
+    ------
+    DataError
+        Fewer than 5 points in a direction, one direction only, only zero speeds.
+    InputError
+        NaN or inf, lengths differ, empty input.
+
+    Examples
+    --------
+    >>> import numpy as np, lugre
+    >>> m = lugre.Model.paper()
+    >>> v = np.concatenate([np.geomspace(2e-4, 0.4, 24), -np.geomspace(2e-4, 0.4, 24)])
+    >>> fit = lugre.fit_static(v, lugre.stribeck(v, m))
+    >>> round(fit.positive.params["fs"], 3)
+    60.2
+    """
+    r = _core.fit_static_points(_array("v", v), _array("F", F), str(weighting),
+                                int(max_iter), float(scale_floor))
+    fit = StaticFit(
+        positive=DirectionFit._from_core(r["positive"]),
+        negative=DirectionFit._from_core(r["negative"]),
+        weights=r["weights"],
+        rejected=list(r["rejected"]),
+        n_zero_speed=int(r["n_zero_speed"]),
+        weighting=r["weighting"],
+        notes=list(r["notes"]),
+    )
+    if not fit.converged:
+        warnings.warn("static fit: IRLS reached its iteration limit before the weights "
+                      "settled; check the rejected points", ConvergenceWarning, stacklevel=2)
+    return fit
+
+
+@dataclass
+class SteadyStatePoints:
+    """Steady-state points found in a raw constant-velocity record."""
+
+    v: np.ndarray
+    """Mean measured velocity of each point [m/s]."""
+    F: np.ndarray
+    """Mean force of each point [N]."""
+    F_std: np.ndarray
+    """Standard deviation of the force samples behind each point [N]."""
+    plateaus: list[dict[str, Any]]
+    """Every detected plateau: start/end sample, nominal velocity, first sample used,
+    whether it settled."""
+    used: np.ndarray
+    """Boolean mask of the samples that went into a point."""
+    notes: list[str]
+    """What was skipped and why."""
+
+
+def steady_state_points(recording: Recording | str, force_constant: float | None = None, *,
+                        columns: dict[str, str] | None = None, settle_fraction: float = 0.3,
+                        velocity_tolerance: float = 0.02, chunks: int = 1,
+                        min_samples: int = 20) -> SteadyStatePoints:
+    """Find constant-velocity plateaus in a raw record, drop transients, average.
+
+    Plateaus are runs of constant ``v_ref`` when the record has it, else runs of nearly
+    constant velocity differentiated from ``x``. The first ``settle_fraction`` of each,
+    and any part where the speed is still off by more than ``velocity_tolerance``
+    (relative), is dropped; plateaus that never settle (creep below the Stribeck
+    velocity) are reported in ``notes`` and skipped.
+
+    Parameters
+    ----------
+    recording : Recording or path
+        With ``t``, ``x`` and ``F`` or ``i`` (then ``force_constant`` is needed).
+    force_constant : float, optional
+        K_F [N/A] for a record of currents.
+    columns : dict, optional
+        Column mapping when ``recording`` is a path.
+    settle_fraction, velocity_tolerance, chunks, min_samples
+        See above; ``chunks > 1`` cuts each settled plateau into replicate points.
+    """
+    rec = recording if isinstance(recording, Recording) else read_recording(recording, columns)
+    F = rec.force(force_constant)
+    r = _core.plateaus(rec.t, rec.x, np.ascontiguousarray(F, dtype=float),
+                       None if rec.v_ref is None else rec.v_ref, float(settle_fraction),
+                       float(velocity_tolerance), 0, int(min_samples), int(chunks))
+    plateaus = [
+        {"start": s, "end": e, "velocity": v, "first_used": f, "settled": ok}
+        for s, e, v, f, ok in zip(r["segment_start"], r["segment_end"], r["segment_velocity"],
+                                  r["segment_first_used"], r["segment_settled"])
+    ]
+    return SteadyStatePoints(v=r["v"], F=r["F"], F_std=r["F_std"], plateaus=plateaus,
+                             used=np.asarray(r["used"], dtype=bool), notes=list(r["notes"]))
+
+
+@dataclass
+class DynamicFit:
+    """Result of :func:`fit_dynamic`."""
+
+    sigma0: float
+    sigma1: float
+    std_err: dict[str, float]
+    ci95: dict[str, tuple[float, float]]
+    identifiable: dict[str, bool]
+    """Whether the record determines each parameter (95 % interval within +-50 %)."""
+    correlation: float
+    """Correlation of the ln(sigma0) and ln(sigma1) estimates."""
+    notes: list[str]
+    """Plain-language verdicts and the experiments that would determine the rest."""
+    residuals: np.ndarray
+    """Measured minus simulated position [m]."""
+    weights: np.ndarray
+    rms_error: float
+    max_error: float
+    iterations: int
+    evaluations: int
+    converged: bool
+    model: Model
+    """The input model with the estimated sigma0 and sigma1."""
+
+    def to_model(self) -> Model:
+        """The model with the estimated sigma0 and sigma1."""
+        return self.model.copy()
+
+    def summary(self, truth: dict[str, float] | None = None) -> str:
+        """Estimates, intervals, verdicts (and errors against ``truth`` when given)."""
+        lines = [f"dynamic fit: {self.evaluations} closed-loop simulations, "
+                 f"rms position error {self.rms_error:.3g} m, max {self.max_error:.3g} m"]
+        for k in ("sigma0", "sigma1"):
+            val = getattr(self, k)
+            lo, hi = self.ci95[k]
+            row = (f"  {k:7s} {val:12.6g}   95 % CI [{lo:.6g}, {hi:.6g}]   "
+                   f"{'determined' if self.identifiable[k] else 'NOT determined by this record'}")
+            if truth is not None and k in truth:
+                row += f"   truth {truth[k]:.6g}  error {100 * (val - truth[k]) / truth[k]:+.2f} %"
+            lines.append(row)
+        lines += [f"  note: {n}" for n in self.notes]
+        return "\n".join(lines)
+
+
+def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str = "igg",
+                c1: float = 1.0, c2: float = 0.0, sigma0_start: float | None = None,
+                sigma1_start: float | None = None, grid: bool = True, max_iter: int = 20,
+                scale_floor: float = 0.0, substeps: int = 1, integrator: str = "exact",
+                columns: dict[str, str] | None = None) -> DynamicFit:
+    """Estimate sigma0 and sigma1 from a closed-loop record (seed paper, eq. 18).
+
+    The model's controller is simulated on the record's ``x_ref`` with the static sets
+    held; ``c1*sum(w*e^2) + c2*max|e|`` of the position error ``e`` is minimised over
+    ``ln sigma0, ln sigma1`` by Nelder-Mead inside IRLS.
+
+    Parameters
+    ----------
+    recording : Recording or path
+        With ``t``, ``x`` (measured position) and ``x_ref``.
+    model : Model, dict or path
+        Axis, static friction sets and the ``pid`` controller that produced the record.
+    weighting : {"igg", "huber", "tukey", "none"}
+    c1, c2 : float
+        Weights of the sum of squares and of the largest error (eq. 18).
+    sigma0_start, sigma1_start : float, optional
+        Start values (default: the model's).
+    grid : bool
+        Evaluate a coarse grid first (protects against a poor start).
+    max_iter, scale_floor, substeps, integrator
+        IRLS iterations, lower bound of the residual scale [m] (e.g. the encoder
+        resolution), and simulation settings.
+    columns : dict, optional
+        Column mapping when ``recording`` is a path.
+
+    Warns
+    -----
+    IdentifiabilityWarning
+        A parameter is not determined by the record (its notes say what would).
+    """
+    m = _as_model(model)
+    rec = recording if isinstance(recording, Recording) else read_recording(recording, columns)
+    if rec.x_ref is None:
+        raise InputError.at("x_ref", f"{rec.source or 'the recording'} has no x_ref column: "
+                            "the dynamic fit simulates the closed loop on the reference")
+    r = _core.fit_dynamic_record(
+        m.to_json(indent=None), rec.t, rec.x_ref, rec.x, str(weighting), float(c1),
+        float(c2), sigma0_start, sigma1_start, bool(grid), int(max_iter), float(scale_floor),
+        int(substeps), str(integrator))
+    names = ("sigma0", "sigma1")
+    fit = DynamicFit(
+        sigma0=float(r["sigma0"]), sigma1=float(r["sigma1"]),
+        std_err=dict(zip(names, map(float, r["std_err"]))),
+        ci95={k: (float(lo), float(hi)) for k, lo, hi in zip(names, r["ci_low"], r["ci_high"])},
+        identifiable=dict(zip(names, map(bool, r["identifiable"]))),
+        correlation=float(r["correlation"]), notes=list(r["notes"]),
+        residuals=r["residuals"], weights=r["weights"], rms_error=float(r["rms_error"]),
+        max_error=float(r["max_error"]), iterations=int(r["iterations"]),
+        evaluations=int(r["evaluations"]), converged=bool(r["converged"]),
+        model=m.with_friction(sigma0=float(r["sigma0"]), sigma1=float(r["sigma1"])),
+    )
+    for k in names:
+        if not fit.identifiable[k]:
+            warnings.warn(f"{k} is not determined by this record: " + " ".join(fit.notes),
+                          IdentifiabilityWarning, stacklevel=2)
+    if not fit.converged:
+        warnings.warn("dynamic fit: IRLS reached its iteration limit", ConvergenceWarning,
+                      stacklevel=2)
+    return fit
