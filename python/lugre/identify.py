@@ -118,8 +118,8 @@ class StaticFit:
     def summary(self, truth: dict[str, dict[str, float]] | None = None) -> str:
         """A table a person reads: estimates, 95 % intervals, and errors against ``truth``
         (``{"positive": {...}, "negative": {...}}``) when given."""
-        lines = [f"static fit ({self.weighting} weights): {len(self.rejected)} points "
-                 f"rejected as gross errors {self.rejected}"]
+        lines = [(f"static fit ({self.weighting} weights): {len(self.rejected)} points "
+                 f"rejected as gross errors {self.rejected}")]
         for name, d in (("v > 0", self.positive), ("v < 0", self.negative)):
             lines.append(f"  {name}  (IRLS iterations {d.iterations}, "
                          f"{'converged' if d.converged else 'NOT converged'}, "
@@ -277,8 +277,8 @@ class DynamicFit:
 
     def summary(self, truth: dict[str, float] | None = None) -> str:
         """Estimates, intervals, verdicts (and errors against ``truth`` when given)."""
-        lines = [f"dynamic fit: {self.evaluations} closed-loop simulations, "
-                 f"rms position error {self.rms_error:.3g} m, max {self.max_error:.3g} m"]
+        lines = [(f"dynamic fit: {self.evaluations} closed-loop simulations, "
+                 f"rms position error {self.rms_error:.3g} m, max {self.max_error:.3g} m")]
         for k in ("sigma0", "sigma1"):
             val = getattr(self, k)
             lo, hi = self.ci95[k]
