@@ -13,9 +13,9 @@ import time
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import lugre  # noqa: E402
-from lugre.diagnose import diagnose  # noqa: E402
-from lugre.diagnose.synth import concealed  # noqa: E402
+import lugre
+from lugre.diagnose import diagnose
+from lugre.diagnose.synth import concealed
 
 
 def main() -> None:
