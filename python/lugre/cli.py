@@ -84,6 +84,13 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_paper(args: argparse.Namespace) -> int:
+    from .paper import run_paper
+
+    run_paper(args.out, seed=args.seed, monte_carlo=args.monte_carlo)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand."""
     p = argparse.ArgumentParser(
@@ -127,6 +134,14 @@ def build_parser() -> argparse.ArgumentParser:
                     help="encoder resolution [m]: lower bound of the residual scale")
     fd.add_argument("--columns", **c)
     fd.set_defaults(func=_cmd_fit_dynamic)
+
+    pp = sub.add_parser("paper", help="rerun the seed paper's experiments (Tables 1 and 2, "
+                        "speed tracking) beside its numbers, with PNG figures")
+    pp.add_argument("--out", default="lugre-paper", help="directory for the figures")
+    pp.add_argument("--seed", type=int, default=1, help="random seed of the synthetic data")
+    pp.add_argument("--monte-carlo", type=int, default=40,
+                    help="static datasets for the Monte Carlo summary (0 to skip)")
+    pp.set_defaults(func=_cmd_paper)
     return p
 
 

@@ -255,7 +255,8 @@ class DynamicFit:
     std_err: dict[str, float]
     ci95: dict[str, tuple[float, float]]
     identifiable: dict[str, bool]
-    """Whether the record determines each parameter (95 % interval within +-50 %)."""
+    """Whether the record determines each parameter (95 % interval within +-50 %, and
+    within +-25 % once the static step's uncertainty is carried over)."""
     correlation: float
     """Correlation of the ln(sigma0) and ln(sigma1) estimates."""
     notes: list[str]
@@ -295,7 +296,8 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
                 c1: float = 1.0, c2: float = 0.0, sigma0_start: float | None = None,
                 sigma1_start: float | None = None, grid: bool = True, max_iter: int = 20,
                 scale_floor: float = 0.0, substeps: int = 1, integrator: str = "exact",
-                columns: dict[str, str] | None = None) -> DynamicFit:
+                columns: dict[str, str] | None = None,
+                static_fit: StaticFit | None = None) -> DynamicFit:
     """Estimate sigma0 and sigma1 from a closed-loop record (seed paper, eq. 18).
 
     The model's controller is simulated on the record's ``x_ref`` with the static sets
@@ -320,6 +322,11 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
         resolution), and simulation settings.
     columns : dict, optional
         Column mapping when ``recording`` is a path.
+    static_fit : StaticFit, optional
+        The static step whose sets the model holds. Its uncertainty is carried into the
+        intervals of sigma0 and sigma1 (delta method: one refit per static parameter
+        moved by its standard error), since a static error shifts the dynamic estimates
+        (sigma1 above all: the presliding damping is sigma1 + sigma2).
 
     Warns
     -----
@@ -331,21 +338,62 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
     if rec.x_ref is None:
         raise InputError.at("x_ref", f"{rec.source or 'the recording'} has no x_ref column: "
                             "the dynamic fit simulates the closed loop on the reference")
-    r = _core.fit_dynamic_record(
-        m.to_json(indent=None), rec.t, rec.x_ref, rec.x, str(weighting), float(c1),
-        float(c2), sigma0_start, sigma1_start, bool(grid), int(max_iter), float(scale_floor),
-        int(substeps), str(integrator))
+    def run(mm: Model, s0: float | None, s1: float | None, use_grid: bool) -> dict[str, Any]:
+        return _core.fit_dynamic_record(
+            mm.to_json(indent=None), rec.t, rec.x_ref, rec.x, str(weighting), float(c1),
+            float(c2), s0, s1, use_grid, int(max_iter), float(scale_floor), int(substeps),
+            str(integrator))
+
+    r = run(m, sigma0_start, sigma1_start, bool(grid))
     names = ("sigma0", "sigma1")
+    est = np.array([r["sigma0"], r["sigma1"]], dtype=float)
+    lo, hi = np.asarray(r["ci_low"], float), np.asarray(r["ci_high"], float)
+    notes = list(r["notes"])
+    identifiable = [bool(b) for b in r["identifiable"]]
+    if static_fit is not None:
+        # delta method on ln(sigma): noise part from the core's interval, static part
+        # from refits with each static parameter moved by one standard error
+        var = ((np.log(hi) - np.log(lo)) / (2 * 1.96)) ** 2
+        shifts = []
+        for d in ("positive", "negative"):
+            df = getattr(static_fit, d)
+            for k in STATIC_NAMES:
+                se = df.std_err[k]
+                if not np.isfinite(se) or se <= 0:
+                    continue
+                sets = {dd: dict(getattr(m, dd)) for dd in ("positive", "negative")}
+                sets[d][k] = sets[d][k] + se
+                if sets[d]["fs"] < sets[d]["fc"]:
+                    continue
+                rr = run(m.with_friction(**sets), float(est[0]), float(est[1]), False)
+                shifts.append(np.log([rr["sigma0"], rr["sigma1"]]) - np.log(est))
+        if shifts:
+            static_var = np.sum(np.square(shifts), axis=0)
+            var = var + static_var
+            half = 1.96 * np.sqrt(var)
+            lo, hi = est * np.exp(-half), est * np.exp(half)
+            rel = (hi - lo) / (2 * est)
+            for j, k in enumerate(names):
+                share = static_var[j] / var[j]
+                was = identifiable[j]
+                identifiable[j] = bool(identifiable[j] and rel[j] <= 0.25)
+                notes.append(
+                    f"{k}: with the static step's uncertainty carried over, the 95 % interval "
+                    f"is [{lo[j]:.5g}, {hi[j]:.5g}] (+-{100 * rel[j]:.0f} %), "
+                    f"{100 * share:.0f} % of its variance from the static parameters"
+                    + ("; NOT determined: measure it directly (presliding or break-away "
+                       "tests with small displacements) or tighten the static step"
+                       if was and not identifiable[j] else ""))
     fit = DynamicFit(
-        sigma0=float(r["sigma0"]), sigma1=float(r["sigma1"]),
+        sigma0=float(est[0]), sigma1=float(est[1]),
         std_err=dict(zip(names, map(float, r["std_err"]))),
-        ci95={k: (float(lo), float(hi)) for k, lo, hi in zip(names, r["ci_low"], r["ci_high"])},
-        identifiable=dict(zip(names, map(bool, r["identifiable"]))),
-        correlation=float(r["correlation"]), notes=list(r["notes"]),
+        ci95={k: (float(a), float(b)) for k, a, b in zip(names, lo, hi)},
+        identifiable=dict(zip(names, identifiable)),
+        correlation=float(r["correlation"]), notes=notes,
         residuals=r["residuals"], weights=r["weights"], rms_error=float(r["rms_error"]),
         max_error=float(r["max_error"]), iterations=int(r["iterations"]),
         evaluations=int(r["evaluations"]), converged=bool(r["converged"]),
-        model=m.with_friction(sigma0=float(r["sigma0"]), sigma1=float(r["sigma1"])),
+        model=m.with_friction(sigma0=float(est[0]), sigma1=float(est[1])),
     )
     for k in names:
         if not fit.identifiable[k]:
