@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from ._native import friction_force, simulate, simulate_batch, stribeck
 from ._result import SimResult
+from .diagnose import Diagnosis, diagnose, evaluate, fit_inverse_dynamics
 from .exceptions import (
     ConvergenceWarning,
     DataError,
@@ -41,6 +42,7 @@ __version__ = "0.1.0"
 __all__ = [
     "ConvergenceWarning",
     "DataError",
+    "Diagnosis",
     "DynamicFit",
     "FileFormatError",
     "IdentifiabilityWarning",
@@ -56,7 +58,10 @@ __all__ = [
     "StaticFit",
     "SteadyStatePoints",
     "UnitsWarning",
+    "diagnose",
+    "evaluate",
     "fit_dynamic",
+    "fit_inverse_dynamics",
     "fit_static",
     "friction_force",
     "load_model",

@@ -84,6 +84,84 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _write_json(path: str, obj: object) -> None:
+    import json
+
+    from .io import _atomic_write
+
+    _atomic_write(path, (json.dumps(obj, indent=2, default=_jsonable) + "\n").encode())
+
+
+def _jsonable(o: object) -> object:
+    import numpy as np
+
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, np.generic):
+        return o.item()
+    raise TypeError(f"cannot write {type(o).__name__} to JSON")
+
+
+def _cmd_diagnose(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .diagnose import diagnose, write_plots
+    from .io import read_recording
+    from .model import load_model, save_model
+
+    _guard_output(args.json, args.recording, args.model, args.holdout)
+    _guard_output(args.out_model, args.recording, args.model, args.holdout)
+    model = load_model(args.model)
+    rec = read_recording(args.recording, _columns(args.columns))
+    hold = read_recording(args.holdout, _columns(args.columns)) if args.holdout else None
+    d = diagnose(rec, model, holdout=hold)
+    print(d.summary())
+    _write_json(args.json, d.to_dict())
+    print(f"report written to {args.json}")
+    if args.out_model:
+        save_model(d.augmented_model(), args.out_model)
+        print(f"augmented model written to {args.out_model}")
+    plots = args.plots or str(Path(args.json).with_suffix("")) + "_plots"
+    files = write_plots(d, plots)
+    print(f"{len(files)} plots written to {plots}/")
+    return 0
+
+
+def _cmd_evaluate(args: argparse.Namespace) -> int:
+    from .diagnose import evaluate
+    from .io import read_recording
+    from .model import load_model
+
+    _guard_output(args.json, args.recording, args.model)
+    ev = evaluate(read_recording(args.recording, _columns(args.columns)), load_model(args.model))
+    print(f"rms force residual {ev['rms_force']:.4g} N, nrmse {ev['nrmse_force']:.4g}")
+    _write_json(args.json, ev)
+    print(f"evaluation written to {args.json}")
+    return 0
+
+
+def _cmd_fit(args: argparse.Namespace) -> int:
+    from .diagnose import fit_inverse_dynamics
+    from .io import read_recording
+    from .model import save_model
+
+    _guard_output(args.json, args.recording)
+    rec = read_recording(args.recording, _columns(args.columns))
+    if rec.F is None and args.force_constant is None:
+        raise InputError.at("--force-constant", f"{args.recording} holds the current i: give "
+                            "the force constant K_F [N/A] with --force-constant")
+    model = fit_inverse_dynamics(rec, mass=args.mass, force_constant=args.force_constant or 1.0)
+    for d in ("positive", "negative"):
+        p = getattr(model, d)
+        print(f"{d:8s} fc {p['fc']:.4g} N  fs {p['fs']:.4g} N  sigma2 {p['sigma2']:.4g} N s/m  "
+              f"vs {p['vs']:.4g} m/s")
+    print(f"mass {model.mass:.4g} kg, sigma0 {model.sigma0:.4g} N/m (guess), "
+          f"force constant {model.force_constant:.4g} N/A")
+    save_model(model, args.json)
+    print(f"model written to {args.json}")
+    return 0
+
+
 def _cmd_paper(args: argparse.Namespace) -> int:
     from .paper import run_paper
 
@@ -134,6 +212,36 @@ def build_parser() -> argparse.ArgumentParser:
                     help="encoder resolution [m]: lower bound of the residual scale")
     fd.add_argument("--columns", **c)
     fd.set_defaults(func=_cmd_fit_dynamic)
+
+    dg = sub.add_parser("diagnose", help="locate where the model misses the recording, name "
+                        "the missing physics, refit, and show the gain on held-out data")
+    dg.add_argument("recording", metavar="RECORDING")
+    dg.add_argument("--model", required=True, metavar="MODEL.json")
+    dg.add_argument("--holdout", metavar="RECORDING2", help="a second run for validation")
+    dg.add_argument("--json", required=True, metavar="REPORT.json")
+    dg.add_argument("--out-model", metavar="AUGMENTED.json",
+                    help="the model with the findings added to its effects")
+    dg.add_argument("--plots", metavar="DIR", help="PNG directory (default: REPORT_plots/)")
+    dg.add_argument("--columns", **c)
+    dg.set_defaults(func=_cmd_diagnose)
+
+    ev = sub.add_parser("evaluate", help="rms and normalised rms of the inverse-dynamics force "
+                        "residual of a model on a recording")
+    ev.add_argument("recording", metavar="RECORDING")
+    ev.add_argument("--model", required=True, metavar="MODEL.json")
+    ev.add_argument("--json", required=True, metavar="EVAL.json")
+    ev.add_argument("--columns", **c)
+    ev.set_defaults(func=_cmd_evaluate)
+
+    ft = sub.add_parser("fit", help="identify mass and LuGre friction from any recording with "
+                        "motion in both directions (robust inverse dynamics)")
+    ft.add_argument("recording", metavar="RECORDING")
+    ft.add_argument("--json", required=True, metavar="MODEL.json")
+    ft.add_argument("--mass", type=float, help="known moving mass [kg] (estimated otherwise)")
+    ft.add_argument("--force-constant", type=float,
+                    help="K_F [N/A]; needed when the recording holds the current i")
+    ft.add_argument("--columns", **c)
+    ft.set_defaults(func=_cmd_fit)
 
     pp = sub.add_parser("paper", help="rerun the seed paper's experiments (Tables 1 and 2, "
                         "speed tracking) beside its numbers, with PNG figures")

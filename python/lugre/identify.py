@@ -21,7 +21,7 @@ import numpy as np
 
 from . import _core
 from ._native import _array
-from .exceptions import ConvergenceWarning, IdentifiabilityWarning, InputError
+from .exceptions import ConvergenceWarning, DataError, IdentifiabilityWarning, InputError
 from .io import Recording, read_recording
 from .model import Model, ModelLike, _as_model
 
@@ -292,6 +292,31 @@ class DynamicFit:
         return "\n".join(lines)
 
 
+def _check_stick_slip(rec: Recording) -> None:
+    """The record must move and stick: sigma0 and sigma1 act near zero velocity."""
+    src = rec.source or "the recording"
+    x = np.asarray(rec.x, float)
+    travel = float(np.ptp(x))
+    steps = np.abs(np.diff(x))
+    resolution = float(steps[steps > 0].min()) if np.any(steps > 0) else 0.0
+    if travel == 0.0 or travel < 10 * resolution:
+        raise DataError(
+            f"{src}: the axis does not move (position range {travel:.3g} m): the dynamic "
+            "fit needs a closed-loop record with motion that sticks and slips"
+        )
+    dt = float(np.median(np.diff(rec.t)))
+    w = max(1, int(round(0.01 / dt)))  # 10 ms windows
+    n = (len(x) - 1) // w
+    v = np.abs(x[w: (n + 1) * w: w] - x[: n * w: w]) / (w * dt)
+    if n < 3 or not np.any(v <= 0.02 * v.max()):
+        raise DataError(
+            f"{src}: no stick phase: the speed never falls near zero (slowest 10 ms window "
+            f"{v.min() if n else float('nan'):.3g} m/s against {v.max() if n else 0:.3g} m/s "
+            "peak). sigma0 and sigma1 act where the axis sticks: record a slow ramp or "
+            "reversals through a soft position loop (stick-slip)"
+        )
+
+
 def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str = "igg",
                 c1: float = 1.0, c2: float = 0.0, sigma0_start: float | None = None,
                 sigma1_start: float | None = None, grid: bool = True, max_iter: int = 20,
@@ -344,6 +369,7 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
             float(c2), s0, s1, use_grid, int(max_iter), float(scale_floor), int(substeps),
             str(integrator))
 
+    _check_stick_slip(rec)
     r = run(m, sigma0_start, sigma1_start, bool(grid))
     names = ("sigma0", "sigma1")
     est = np.array([r["sigma0"], r["sigma1"]], dtype=float)
