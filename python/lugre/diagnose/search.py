@@ -272,7 +272,8 @@ def forward_select(
             ok, why = accept(evid, alpha=alpha, min_gain=min_gain)
             start = q + sum(t.X.shape[1] for t in trial[:-1])
             beta = ev.beta[start:start + term.X.shape[1]]
-            contrib = float(np.std(np.einsum("ij,j->i", term.X, beta)[m]))
+            # rms, not std: a constant force is a contribution too
+            contrib = float(np.sqrt(np.mean(np.einsum("ij,j->i", term.X, beta)[m] ** 2)))
             if ok and c.effect == "delay" and beta[0] < 0.2 * dt:
                 ok, why = False, (f"lag of {beta[0] * 1e3:.3g} ms is below a fifth of the "
                                   "sample interval: a timing detail of the sampled record")
