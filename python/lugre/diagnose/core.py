@@ -28,10 +28,102 @@ _EXPERIMENT = {
         "by 3 dB at its bandwidth"
     ),
     ("offset", "asymmetry"): (
-        "hold the axis at rest under position control at several positions: a constant "
-        "force shows as a steady holding current, an asymmetric Coulomb level does not"
+        "hold the axis at rest under position control at several positions, approaching "
+        "each from both sides: a constant force shows as a steady holding current whose "
+        "mean over the two approaches is the offset, an asymmetric Coulomb level gives "
+        "holding currents that average to zero"
     ),
 }
+
+#: Coulomb/static levels an offset shifts: +F forward, -F backward (the friction of the
+#: CONTRACT opposes the motion, the offset adds to the force the motor must give).
+_OFFSET_LEVELS = {"positive.fc": 1.0, "positive.fs": 1.0, "negative.fc": -1.0,
+                  "negative.fs": -1.0}
+
+
+def _moves(beta: np.ndarray, names: list[str], tol: np.ndarray) -> dict[str, float]:
+    """Base changes in units of their tolerance (prior standard deviation)."""
+    return {n: float(b / t) for n, b, t in zip(names, beta, tol)}
+
+
+def _offset_alternative(scorer: Scorer, terms: list[Term], ev: Any, names: list[str],
+                        tol: np.ndarray, model: Model, sig: R.Signals, min_gain: float
+                        ) -> tuple[dict[str, Any] | None, str]:
+    """Weigh the offset against per-direction Coulomb/static levels (parsimony).
+
+    The same data are fitted once with the offset and once without it (the base
+    levels free); the held-out errors are compared, and the base moves of each story
+    are counted in units of their tolerance. Returns the alternative (when the two fit
+    about equally well on held-out data) and a sentence for the evidence.
+    """
+    k = next(j for j, t in enumerate(terms) if t.effect == "offset")
+    rest = [t for t in terms if t.effect != "offset"]
+    # the alternative at its best: Coulomb/static levels free (flat prior)
+    free_tol = np.array([t * (1e3 if n in _OFFSET_LEVELS else 1.0) for n, t in zip(names, tol)])
+    alt = Scorer(scorer.r, scorer.J, free_tol, scorer.mask, scorer.s2, scorer.K,
+                 center=scorer.center).evaluate(rest)
+    q = len(names)
+    m_off = _moves(ev.beta[:q], names, tol)
+    m_alt = _moves(alt.beta[:q], names, tol)
+    cost_off = float(sum(v * v for v in m_off.values()))
+    cost_alt = float(sum(v * v for v in m_alt.values()))
+    big_alt = {n: v for n, v in m_alt.items() if abs(v) >= 1.0}
+    big_off = {n: v for n, v in m_off.items() if abs(v) >= 1.0}
+    d_fit = float((alt.sse_b.sum() - ev.sse_b.sum()) / scorer.s2)
+    start = q + sum(t.X.shape[1] for t in terms[:k])
+    force = float(ev.beta[start])
+    levels = {n: E.get_base(model, n) + ev.beta[names.index(n)]
+              for n in _OFFSET_LEVELS if n in names}
+    alt_levels = {n: E.get_base(model, n) + alt.beta[names.index(n)]
+                  for n in _OFFSET_LEVELS if n in names}
+    alt_txt = ", ".join(f"{n} {v:.3g} N" for n, v in alt_levels.items())
+    verdict = ("fit the held-out blocks about as well" if d_fit <= 3.0 * min_gain else
+               f"fit the held-out blocks worse by {d_fit:.0f} (chi-square)")
+    txt = (f"Parsimony: one parameter (offset {force:.3g} N, {len(big_off)} base parameters "
+           f"moved by over one tolerance, sum of squared moves {cost_off:.0f}) against "
+           f"asymmetric Coulomb/static levels ({alt_txt}), which move {len(big_alt)} base "
+           f"parameters by over one tolerance (sum of squared moves {cost_alt:.0f}) and "
+           f"{verdict}.")
+    rest_txt = _rest_evidence(sig)
+    if rest_txt:
+        txt += " " + rest_txt
+    if d_fit > 3.0 * min_gain:
+        return None, txt
+    return {
+        "effect": "asymmetric_friction",
+        "parameters": {**{n: float(v) for n, v in alt_levels.items()},
+                       "moves_in_tolerances": {n: round(v, 2) for n, v in big_alt.items()}},
+        "note": (f"Coulomb/static levels shifted by direction ({alt_txt}, against "
+                 f"{', '.join(f'{n} {v:.3g} N' for n, v in levels.items())} with the "
+                 "offset) fit the motion about as well but move more parameters"),
+        "experiment": _EXPERIMENT[("offset", "asymmetry")],
+    }, txt
+
+
+def _rest_evidence(sig: R.Signals, min_s: float = 0.2) -> str:
+    """Mean motor force in stretches at rest (entered from either side), if any."""
+    still = (sig.v == 0.0) & sig.mask
+    n_min = int(min_s * sig.fs)
+    runs = []
+    k = 0
+    n = still.size
+    while k < n:
+        if still[k]:
+            j = k
+            while j < n and still[j]:
+                j += 1
+            if j - k >= n_min:
+                runs.append((k, j))
+            k = j
+        else:
+            k += 1
+    if not runs:
+        return ""
+    means = [float(np.mean(sig.fm_f[a:b])) for a, b in runs]
+    tot = sum(b - a for a, b in runs) / sig.fs
+    return (f"At rest ({len(runs)} stretches, {tot:.2g} s) the motor force averages "
+            f"{np.mean(means):.3g} N (friction can hold any force up to the static level "
+            "there, so this bounds rather than measures the offset).")
 
 
 def _rec(recording: Any) -> Recording:
@@ -326,6 +418,7 @@ def diagnose(
     terms, ev, log = forward_select(scorer, ctx, cands, alpha=alpha, min_gain=min_gain,
                                     noise_rms=noise["rms"])
     q = J.shape[1]
+    ev_sel = ev
     d, betas = _split(ev.beta, q, terms)
     base = {n: E.get_base(model, n) for n, _ in E.BASE_PARAMS}
     for n, dv in zip(names, d):
@@ -388,8 +481,10 @@ def diagnose(
             extra = (f"Largest change x{sc[j]:.3g} of the Coulomb/static level at "
                      f"x = {e0['positions'][j]:.4g} m.")
         if t.effect == "offset":
-            extra = ("Without it, the Coulomb and static levels of both directions would "
-                     "have to move in opposite senses.")
+            alt_off, extra = _offset_alternative(scorer, terms, ev_sel, names, tol, model,
+                                                 sig, min_gain)
+            if alt_off is not None:
+                alternatives.setdefault(k, []).append(alt_off)
         f = Finding(effect=e0["effect"],
                     parameters={a: v for a, v in e0.items() if a != "effect"},
                     where=t.cand.where(t.h, betas[k], ctx), explained=expl,
@@ -419,7 +514,7 @@ def diagnose(
     if not any(f.effect == "offset" for f in findings) and abs(bp - bn) > 0.1 * (bp + bn) / 2:
         notes.append(
             f"The Coulomb levels differ by direction ({bp:.3g} N forward, {bn:.3g} N "
-            f"backward); a constant force of {(bn - bp) / 2:.3g} N with a symmetric level "
+            f"backward); a constant force of {(bp - bn) / 2:.3g} N with a symmetric level "
             f"would fit the motion equally well. To separate: "
             f"{_EXPERIMENT[('offset', 'asymmetry')]}.")
 
