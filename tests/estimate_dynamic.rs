@@ -95,3 +95,56 @@ fn bad_inputs() {
     };
     assert!(fit_dynamic(&m, &t, &xr, &xq, &bad).is_err());
 }
+
+#[test]
+fn gross_errors_rejected_and_both_coordinate_choices_agree() {
+    let (m, t, xr, mut xq) = record();
+    // 1 % of the samples hit by encoder glitches of +-20 to 50 um
+    let mut state = 12345u64;
+    let mut uniform = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut glitches = Vec::new();
+    for (k, x) in xq.iter_mut().enumerate() {
+        if uniform() < 0.01 {
+            let sign = if uniform() < 0.5 { -1.0 } else { 1.0 };
+            *x += sign * (20e-6 + 30e-6 * uniform());
+            glitches.push(k);
+        }
+    }
+    let mut start = m.clone();
+    start.friction.sigma0 = 3e4;
+    start.friction.sigma1 = 100.0;
+    let fast = fit_dynamic(&start, &t, &xr, &xq, &DynamicFitOptions::default()).unwrap();
+    let plain = fit_dynamic(
+        &start,
+        &t,
+        &xr,
+        &xq,
+        &DynamicFitOptions {
+            rescale: false,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    for f in [&fast, &plain] {
+        eprintln!(
+            "sigma0 {:.2} sigma1 {:.3} CI1 [{:.2}, {:.2}] simulations {} iterations {}",
+            f.sigma0, f.sigma1, f.ci_low[1], f.ci_high[1], f.evaluations, f.iterations
+        );
+        assert!((f.sigma0 / 1e5 - 1.0).abs() < 0.01, "sigma0 {}", f.sigma0);
+        let rejected = glitches.iter().filter(|&&k| f.weights[k] == 0.0).count();
+        assert!(
+            rejected * 10 >= glitches.len() * 9,
+            "{rejected} of {}",
+            glitches.len()
+        );
+    }
+    // the two coordinate choices agree well inside the intervals
+    let se0 = fast.std_err[0];
+    assert!((fast.sigma0 - plain.sigma0).abs() < 0.5 * se0);
+    assert!((fast.sigma1 - plain.sigma1).abs() < 0.5 * fast.std_err[1]);
+}

@@ -17,7 +17,7 @@
 
 use super::irls::{irls, IrlsSetup};
 use super::nelder_mead::NmOptions;
-use super::robust::Weighting;
+use super::robust::{robust_scale, Weighting};
 use crate::error::{check_finite, check_len, check_time, Error, Result};
 use crate::servo::{simulate, ControlLaw, Drive, Model, SimOptions};
 use rayon::prelude::*;
@@ -45,6 +45,10 @@ pub struct DynamicFitOptions {
     pub tol: f64,
     /// Simulations per Nelder-Mead run.
     pub max_evals: usize,
+    /// Refine the start by a few Huber-weighted Gauss-Newton steps and run Nelder-Mead
+    /// in coordinates decorrelated and scaled by the Gauss-Newton Hessian there (true
+    /// by default; false: Nelder-Mead on the log-parameters from the grid node).
+    pub rescale: bool,
     /// Lower bound of the residual scale [m] (e.g. the encoder resolution).
     pub scale_floor: f64,
     /// Relative uncertainty of sigma2 from the static step, for the note on sigma1
@@ -66,6 +70,7 @@ impl Default for DynamicFitOptions {
             max_iter: 20,
             tol: 1e-3,
             max_evals: 200,
+            rescale: true,
             scale_floor: 0.0,
             sigma2_rel_uncertainty: 0.01,
             sim: SimOptions::default(),
@@ -157,6 +162,120 @@ fn check_options(o: &DynamicFitOptions) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Start point and coordinate map for the Nelder-Mead of [`fit_dynamic`].
+struct LocalMetric {
+    centre: [f64; 2],
+    /// `theta = centre + t*z`.
+    t: [[f64; 2]; 2],
+    /// The last Jacobian (residual sign) and the point where it was taken.
+    jac: ([f64; 2], [Vec<f64>; 2]),
+}
+
+/// Forward-difference Jacobian of the simulated positions, `dx_sim/dtheta_k =
+/// -(de/dtheta_k)`, in the log-parameters (the two simulations in parallel).
+fn jacobian(
+    resid: &(dyn Fn(&[f64]) -> Option<Vec<f64>> + Sync),
+    th: &[f64; 2],
+    e: &[f64],
+    h: f64,
+) -> Option<[Vec<f64>; 2]> {
+    let (a, b) = rayon::join(|| resid(&[th[0] + h, th[1]]), || resid(&[th[0], th[1] + h]));
+    let col =
+        |r: Vec<f64>| -> Vec<f64> { e.iter().zip(&r).map(|(e0, e1)| (e0 - e1) / h).collect() };
+    Some([col(a?), col(b?)])
+}
+
+/// Gauss-Newton refinement of the start (Huber weights, step halving, at most a few
+/// steps) and the map `theta = centre + T*z` with `T = sqrt(f)*L^-T`, `L*L^T = J^T W J`
+/// (Cholesky) at the last Jacobian: in `z` the quadratic model of the cost is
+/// `f*(1 + |z|^2)`. `None` when the Jacobian is singular or a simulation fails (the
+/// caller then works in the log-parameters).
+fn local_metric(
+    resid: &(dyn Fn(&[f64]) -> Option<Vec<f64>> + Sync),
+    theta0: Vec<f64>,
+    c1: f64,
+    evaluations: &mut usize,
+) -> Option<LocalMetric> {
+    let huber = Weighting::huber();
+    let wss = |e: &[f64], w: &[f64]| -> f64 { e.iter().zip(w).map(|(a, b)| b * a * a).sum() };
+    let mut th = [theta0[0], theta0[1]];
+    let mut e = resid(&th)?;
+    *evaluations += 1;
+    let mut metric = None;
+    let mut last_jac = None;
+    for _ in 0..10 {
+        let s = robust_scale(&e);
+        if !(s > 0.0) {
+            break;
+        }
+        let w = huber.weights(&e, s);
+        let j = jacobian(resid, &th, &e, 1e-3)?;
+        *evaluations += 2;
+        let (mut m00, mut m01, mut m11, mut g0, mut g1) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for k in 0..e.len() {
+            let (a, b, wk) = (j[0][k], j[1][k], w[k]);
+            m00 += wk * a * a;
+            m01 += wk * a * b;
+            m11 += wk * b * b;
+            g0 += wk * a * e[k];
+            g1 += wk * b * e[k];
+        }
+        let det = m00 * m11 - m01 * m01;
+        if !(m00 > 0.0 && m11 > 0.0 && det > 1e-12 * m00 * m11) {
+            return None;
+        }
+        metric = Some((m00, m01, m11));
+        last_jac = Some((th, j));
+        // e(th + d) ~ e - J d: d = M^-1 J^T W e
+        let d = [(m11 * g0 - m01 * g1) / det, (m00 * g1 - m01 * g0) / det];
+        let f = wss(&e, &w);
+        let predicted = d[0] * g0 + d[1] * g1; // predicted decrease
+                                               // done when the step would gain less than about one standard error squared
+        if !(predicted > f / e.len() as f64) {
+            break;
+        }
+        let mut lambda = 1.0;
+        let mut accepted = false;
+        for _ in 0..4 {
+            // never more than a factor e per step in either parameter
+            let big = (lambda * d[0]).abs().max((lambda * d[1]).abs());
+            let lam = if big > 1.0 { lambda / big } else { lambda };
+            let trial = [th[0] + lam * d[0], th[1] + lam * d[1]];
+            *evaluations += 1;
+            if let Some(et) = resid(&trial) {
+                if wss(&et, &w) < f {
+                    th = trial;
+                    e = et;
+                    accepted = true;
+                    break;
+                }
+            }
+            lambda = lam * 0.5;
+        }
+        if !accepted {
+            break;
+        }
+    }
+    let (m00, m01, m11) = metric?;
+    let jac = last_jac?;
+    let f = c1 * e.iter().map(|x| x * x).sum::<f64>();
+    let (m00, m01, m11) = (c1 * m00, c1 * m01, c1 * m11);
+    // L = [[l00, 0], [l10, l11]]
+    let l00 = m00.sqrt();
+    let l10 = m01 / l00;
+    let l11 = (m11 - l10 * l10).max(0.0).sqrt();
+    if !(l11 > 0.0 && f > 0.0 && f.is_finite()) {
+        return None;
+    }
+    // L^-T = [[1/l00, -l10/(l00*l11)], [0, 1/l11]]
+    let r = f.sqrt();
+    Some(LocalMetric {
+        centre: th,
+        t: [[r / l00, -r * l10 / (l00 * l11)], [0.0, r / l11]],
+        jac,
+    })
 }
 
 /// Estimate `sigma0` and `sigma1` from a closed-loop position record.
@@ -276,38 +395,98 @@ pub fn fit_dynamic(
             step = vec![ln10 / 4.0, ln10 / 2.0];
         }
     }
-    let setup = IrlsSetup {
-        weighting: opts.weighting,
-        max_outer: opts.max_iter,
-        tol: opts.tol,
-        scale_floor: opts.scale_floor,
-        nm: NmOptions {
-            max_evals: opts.max_evals,
-            xtol: opts.tol.max(1e-8),
-            ftol: 1e-6,
-            restarts: 1,
-        },
-        step: &step,
+    let nm = NmOptions {
+        max_evals: opts.max_evals,
+        xtol: opts.tol.max(1e-8),
+        ftol: 1e-6,
+        restarts: 1,
     };
-    let out = irls(&resid, &objective, theta0, &setup).ok_or_else(|| {
+    let fail = || {
         Error::Data(
             "the closed loop could not be simulated at the start values: give sigma0_start and sigma1_start near the expected values".into(),
         )
-    })?;
+    };
+    let local = if opts.rescale {
+        local_metric(&resid, theta0.clone(), opts.c1, &mut evaluations)
+    } else {
+        None
+    };
+    let mut reuse_jac = None;
+    let out = match local {
+        Some(lm) => {
+            reuse_jac = Some(lm.jac.clone());
+            // Nelder-Mead in z, theta = centre + T*z: the Gauss-Newton model of the
+            // cost is f*(1 + |z|^2) there, so the thin, tilted sigma0/sigma1 valley
+            // becomes round and the simplex needs few evaluations
+            let to_theta = |z: &[f64]| -> [f64; 2] {
+                [
+                    lm.centre[0] + lm.t[0][0] * z[0] + lm.t[0][1] * z[1],
+                    lm.centre[1] + lm.t[1][0] * z[0] + lm.t[1][1] * z[1],
+                ]
+            };
+            let resid_z = |z: &[f64]| resid(&to_theta(z));
+            // |d theta|_inf <= ||T||_inf * |d z|_inf
+            let tnorm =
+                (lm.t[0][0].abs() + lm.t[0][1].abs()).max(lm.t[1][0].abs() + lm.t[1][1].abs());
+            // a few standard errors: the cost rises by ~1/N relative per standard error
+            let n = t.len() as f64;
+            let step_z = [2.0 / n.sqrt(); 2];
+            let setup = IrlsSetup {
+                weighting: opts.weighting,
+                max_outer: opts.max_iter,
+                tol: opts.tol / tnorm.max(1e-300),
+                scale_floor: opts.scale_floor,
+                nm: NmOptions {
+                    xtol: 1e-8,
+                    ftol: nm.ftol.min(0.04 / n),
+                    ..nm
+                },
+                step: &step_z,
+            };
+            let mut o = irls(&resid_z, &objective, vec![0.0, 0.0], &setup).ok_or_else(fail)?;
+            o.theta = to_theta(&o.theta).to_vec();
+            o
+        }
+        None => {
+            let setup = IrlsSetup {
+                weighting: opts.weighting,
+                max_outer: opts.max_iter,
+                tol: opts.tol,
+                scale_floor: opts.scale_floor,
+                nm,
+                step: &step,
+            };
+            irls(&resid, &objective, theta0, &setup).ok_or_else(fail)?
+        }
+    };
     evaluations += out.evals;
     let th = out.theta.clone();
     let (s0, s1) = (th[0].exp(), th[1].exp());
 
-    // Jacobian of the residuals by central differences in the log-parameters
+    // Jacobian of the simulated positions in the log-parameters: the Gauss-Newton one
+    // when it was taken within its own difference step of the estimate, else central
+    // differences here
     let h = 1e-3;
-    let probes: Vec<[f64; 2]> = vec![
-        [th[0] + h, th[1]],
-        [th[0] - h, th[1]],
-        [th[0], th[1] + h],
-        [th[0], th[1] - h],
-    ];
-    let sims: Vec<Option<Vec<f64>>> = probes.par_iter().map(|p| resid(p)).collect();
-    evaluations += 4;
+    let jac: Option<[Vec<f64>; 2]> = match reuse_jac {
+        Some((at, j)) if (at[0] - th[0]).abs().max((at[1] - th[1]).abs()) <= h => Some(j),
+        _ => {
+            let probes: Vec<[f64; 2]> = vec![
+                [th[0] + h, th[1]],
+                [th[0] - h, th[1]],
+                [th[0], th[1] + h],
+                [th[0], th[1] - h],
+            ];
+            let sims: Vec<Option<Vec<f64>>> = probes.par_iter().map(|p| resid(p)).collect();
+            evaluations += 4;
+            match &sims[..] {
+                [Some(a), Some(b), Some(c), Some(d)] => Some([
+                    a.iter().zip(b).map(|(p, q)| (p - q) / (2.0 * h)).collect(),
+                    c.iter().zip(d).map(|(p, q)| (p - q) / (2.0 * h)).collect(),
+                ]),
+                _ => None,
+            }
+        }
+    };
     let w = &out.weights;
     let e = &out.residuals;
     let n_used = w.iter().filter(|x| **x > 0.0).count();
@@ -335,12 +514,11 @@ pub fn fit_dynamic(
     };
     let inflation = (1.0 + rho) / (1.0 - rho);
     let mut singular = false;
-    if let [Some(a), Some(b), Some(c), Some(d)] = &sims[..] {
+    if let Some([ja, jb]) = &jac {
         // de/dtheta = -(dx_sim/dtheta); the sign does not matter for J^T W J
         let mut m = [[0.0f64; 2]; 2];
         for k in 0..e.len() {
-            let j0 = (a[k] - b[k]) / (2.0 * h);
-            let j1 = (c[k] - d[k]) / (2.0 * h);
+            let (j0, j1) = (ja[k], jb[k]);
             m[0][0] += w[k] * j0 * j0;
             m[0][1] += w[k] * j0 * j1;
             m[1][1] += w[k] * j1 * j1;
