@@ -242,8 +242,12 @@ def steady_state_points(recording: Recording | str, force_constant: float | None
         for s, e, v, f, ok in zip(r["segment_start"], r["segment_end"], r["segment_velocity"],
                                   r["segment_first_used"], r["segment_settled"])
     ]
+    notes = list(r["notes"])
+    if len(notes) > 12:
+        notes = notes[:10] + [(f"... and {len(notes) - 10} more plateaus skipped for the same "
+                              "kind of reason (see .plateaus)")]
     return SteadyStatePoints(v=r["v"], F=r["F"], F_std=r["F_std"], plateaus=plateaus,
-                             used=np.asarray(r["used"], dtype=bool), notes=list(r["notes"]))
+                             used=np.asarray(r["used"], dtype=bool), notes=notes)
 
 
 @dataclass
@@ -305,7 +309,7 @@ def _check_stick_slip(rec: Recording) -> None:
             "fit needs a closed-loop record with motion that sticks and slips"
         )
     dt = float(np.median(np.diff(rec.t)))
-    w = max(1, int(round(0.01 / dt)))  # 10 ms windows
+    w = max(1, round(0.01 / dt))  # 10 ms windows
     n = (len(x) - 1) // w
     v = np.abs(x[w: (n + 1) * w: w] - x[: n * w: w]) / (w * dt)
     if n < 3 or not np.any(v <= 0.02 * v.max()):

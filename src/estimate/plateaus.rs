@@ -205,14 +205,29 @@ pub fn plateaus_from_recording(
                 Some(k) => start0.max(k + w),
             };
         }
-        let settled = e > first && e - first >= opts.min_samples.max(2 * chunks);
+        let long_enough = e > first && e - first >= opts.min_samples.max(2 * chunks);
+        // a steady plateau has no trend: the mean speeds of the two halves of the used
+        // part agree within half the tolerance (a ramp cut into pieces does not)
+        let drifting = long_enough && {
+            let mid = first + (e - first) / 2;
+            let v1 = (x[mid] - x[first]) / (t[mid] - t[first]);
+            let v2 = (x[e - 1] - x[mid]) / (t[e - 1] - t[mid]);
+            (v2 - v1).abs() > 0.5 * opts.velocity_tolerance * vnom.abs()
+        };
+        let settled = long_enough && !drifting;
         out.segment_settled.push(settled);
         out.segment_first_used.push(if settled { first } else { e });
         if !settled {
-            out.notes.push(format!(
-                "plateau {si} (v = {vnom:.4e} m/s, samples {s}..{e}) skipped: the velocity did not settle within {:.0} % of its nominal value",
-                opts.velocity_tolerance * 100.0
-            ));
+            out.notes.push(if drifting {
+                format!(
+                    "plateau {si} (v = {vnom:.4e} m/s, samples {s}..{e}) skipped: the speed drifts through it (the axis is still accelerating)"
+                )
+            } else {
+                format!(
+                    "plateau {si} (v = {vnom:.4e} m/s, samples {s}..{e}) skipped: the velocity did not settle within {:.0} % of its nominal value",
+                    opts.velocity_tolerance * 100.0
+                )
+            });
             continue;
         }
         let m = e - first;
@@ -268,6 +283,11 @@ mod tests {
         assert_eq!(p.v.len(), 2, "{p:?}");
         assert!((p.v[0] - 0.05).abs() < 1e-9 && (p.v[1] + 0.02).abs() < 1e-9);
         assert_eq!(p.f, vec![40.0, -35.0]);
+        // a constant acceleration is no plateau, however it is cut
+        let ramp: Vec<f64> = t.iter().map(|&s| 0.05 * s * s).collect();
+        let e =
+            plateaus_from_recording(&t, &ramp, &f, None, &PlateauOptions::default()).unwrap_err();
+        assert!(matches!(e, Error::Data(_)), "{e}");
         let zero = vec![0.0; t.len()];
         let e = plateaus_from_recording(&t, &zero, &f, Some(&zero), &PlateauOptions::default())
             .unwrap_err();
