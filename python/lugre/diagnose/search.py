@@ -39,6 +39,9 @@ class Term:
     h: Any
     X: np.ndarray
     prior: np.ndarray | None = None
+    #: held-out score over the nonlinear parameter (``h``, ``score``, ``beta``), when
+    #: it was chosen by a profile
+    profile: dict[str, np.ndarray] | None = None
 
     @property
     def effect(self) -> str:
@@ -159,6 +162,41 @@ def make_term(c: Candidate, h: Any, ctx: Context) -> Term:
     return Term(cand=c, h=h, X=c.columns(h, ctx), prior=c.prior_tol(h, ctx))
 
 
+def _profile(scorer: Scorer, kept: list[Term], c: Candidate, grid: np.ndarray, ctx: Context
+             ) -> tuple[Term, Evaluation]:
+    """Choose a candidate's nonlinear parameter by the held-out score of the joint fit.
+
+    The score is evaluated on ``grid`` (increasing, log-spaced), then on a fine grid
+    around the best point; the whole profile is kept on the term (for intervals).
+    """
+    q = scorer.J.shape[1]
+    start = q + sum(t.X.shape[1] for t in kept)
+
+    def run(hs: np.ndarray) -> list[tuple[float, float, np.ndarray, Term, Evaluation]]:
+        out = []
+        for h in hs:
+            term = make_term(c, float(h), ctx)
+            ev = scorer.evaluate(kept + [term])
+            out.append((float(h), ev.score, ev.beta[start:start + term.X.shape[1]].copy(),
+                        term, ev))
+        return out
+
+    rows = run(grid)
+    j = int(np.argmin([r[1] for r in rows]))
+    lo = grid[max(j - 1, 0)]
+    hi = grid[min(j + 1, grid.size - 1)]
+    if hi > lo:
+        rows += run(np.geomspace(lo, hi, 11)[1:-1])
+    rows.sort(key=lambda r: r[0])
+    best = min(rows, key=lambda r: r[1])
+    term, ev = best[3], best[4]
+    term.profile = {"h": np.array([r[0] for r in rows]),
+                    "score": np.array([r[1] for r in rows]),
+                    "beta": np.array([r[2] for r in rows]),
+                    "grid_max": float(grid[-1]), "grid_min": float(grid[0])}
+    return term, ev
+
+
 def compare(cur: Evaluation, new: Evaluation, s2: float) -> dict[str, float]:
     """Held-out evidence of ``new`` against ``cur``.
 
@@ -184,22 +222,33 @@ def compare(cur: Evaluation, new: Evaluation, s2: float) -> dict[str, float]:
         p = float(stats.t.sf(t, K - 1))
     pos = float(d[d > 0].sum())
     neg = float(-d[d < 0].sum())
+    fit_gain = float((cur.sse_b.sum() - new.sse_b.sum()) / s2)
+    prior_gain = float(cur.prior - new.prior)
     return {"gain": gain, "t": t, "p": p, "positive": int(np.sum(d > 0)),
-            "ratio": pos / neg if neg > 0 else float("inf")}
+            "ratio": pos / neg if neg > 0 else float("inf"), "fit_gain": fit_gain,
+            "prior_gain": prior_gain,
+            "p_prior": float(stats.chi2.sf(max(prior_gain, 0.0), 1))}
 
 
 def accept(ev: dict[str, float], *, alpha: float, min_gain: float) -> tuple[bool, str]:
     """Decide on a term from :func:`compare`'s evidence.
 
     A term passes when its held-out score gain exceeds ``min_gain`` and either its
-    block gains are consistent (t-test ``p < alpha``), or, for a mismatch confined to
-    part of the record, the gain is overwhelming (over ``20*min_gain``), positive in at
-    least three blocks and at least ten times what the other blocks lose.
+    block gains are consistent (t-test ``p < alpha``), or it fits the held-out blocks at
+    least as well while sparing base moves that the tolerance prior makes improbable
+    (chi-square of the saved prior cost, one degree of freedom, ``p < alpha``: a payload
+    against a mass 20 % off), or, for a mismatch confined to part of the record, the
+    gain is overwhelming (over ``20*min_gain``), positive in at least three blocks and at
+    least ten times what the other blocks lose.
     """
     if ev["gain"] <= min_gain:
         return False, "gain below threshold"
     if ev["p"] < alpha:
         return True, "consistent over blocks"
+    if ev["p_prior"] < alpha and ev["fit_gain"] > -min_gain:
+        # about the same held-out fit, but without it the base must move further from the
+        # model than their tolerance allows (chi-square of the saved moves, p < alpha)
+        return True, "parsimony: spares base moves beyond their tolerance"
     if ev["gain"] > 20 * min_gain and ev["positive"] >= 3 and ev["ratio"] > 10:
         return True, "confined but overwhelming"
     return False, "not consistent over held-out blocks"
@@ -262,12 +311,18 @@ def forward_select(
         for c in cands:
             if c.effect in chosen or c.effect in superseded:
                 continue
-            h = c.choose(cur.resid, ctx)
-            if h is None and c.effect in ("cogging", "drift"):
-                continue
-            term = make_term(c, h, ctx)
-            trial = [t for t in terms if t.effect not in c.supersedes] + [term]
-            ev = scorer.evaluate(trial)
+            kept = [t for t in terms if t.effect not in c.supersedes]
+            grid = c.grid(ctx)
+            if grid is not None:  # nonlinear parameter by its held-out profile
+                term, ev = _profile(scorer, kept, c, grid, ctx)
+                h = term.h
+            else:
+                h = c.choose(cur.resid, ctx)
+                if h is None and c.effect == "cogging":
+                    continue
+                term = make_term(c, h, ctx)
+                ev = scorer.evaluate(kept + [term])
+            trial = kept + [term]
             evid = compare(cur, ev, s2)
             ok, why = accept(evid, alpha=alpha, min_gain=min_gain)
             start = q + sum(t.X.shape[1] for t in trial[:-1])

@@ -28,7 +28,7 @@ EFFECTS: dict[str, dict[str, Any] | None] = {
     "position_friction": {"effect": "position_friction",
                           "positions": [-0.1, -0.06, -0.03, 0.0, 0.1],
                           "scale": [1.0, 1.0, 1.3, 1.0, 1.0]},
-    "drift": {"effect": "drift", "gain": 0.15, "time_constant": 4.0},
+    "drift": {"effect": "drift", "gain": 0.15, "time_constant": 3.0},  # well inside a 10 s record
     "mass": {"effect": "mass", "delta": 5.0},
     "delay": {"effect": "delay", "seconds": 0.002},
     "current_lag": {"effect": "current_lag", "bandwidth": 60.0},
@@ -91,9 +91,22 @@ def concealed(
     d["controller"] = {"type": "pid", "kp": 5e4, "ki": 5e5, "kd": 1500.0, "rate_hz": 10000.0}
     d["effects"] = [] if eff is None else [dict(eff)]
     truth = Model(d)
-    t = np.arange(int(duration * rate_hz)) / rate_hz
+    n = int(duration * rate_hz)
+    t = np.arange(n) / rate_hz
+    # the reference is generated at the controller's rate (as a drive does); a reference
+    # interpolated from the record's rate would put a 1-sample staircase into the
+    # derivative term, a kick the sampled current does not show. Outputs are instantaneous
+    # samples at the record's rate.
+    over = max(1, round(d["controller"]["rate_hz"] / rate_hz))
+    tf = np.arange(n * over) / (rate_hz * over)
+    sf = simulate(truth, tf, reference_trajectory(tf, seed))
     xr = reference_trajectory(t, seed)
-    s = simulate(truth, t, xr)
+
+    class _S:
+        x = sf.x[::over]
+        i = sf.i[::over]
+
+    s = _S
     i = s.i + current_noise * rng.standard_normal(t.size)
     spikes = rng.random(t.size) < spike_rate
     i[spikes] += rng.choice([-1.0, 1.0], spikes.sum())
