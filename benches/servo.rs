@@ -111,13 +111,17 @@ fn closed_loop(c: &mut Criterion) {
         });
         if steps <= 1_000_000 {
             let (tf, xrf) = grid(steps, steps + 1);
-            g.bench_with_input(BenchmarkId::new("lugre_full_output", steps), &steps, |b, _| {
-                b.iter(|| {
-                    simulate(&model, &tf, Drive::Position(&xrf), &opts, &mut || true)
-                        .unwrap()
-                        .x
-                })
-            });
+            g.bench_with_input(
+                BenchmarkId::new("lugre_full_output", steps),
+                &steps,
+                |b, _| {
+                    b.iter(|| {
+                        simulate(&model, &tf, Drive::Position(&xrf), &opts, &mut || true)
+                            .unwrap()
+                            .x
+                    })
+                },
+            );
         }
     }
     g.finish();

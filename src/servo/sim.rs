@@ -108,7 +108,12 @@ impl<'a> Interp<'a> {
 }
 
 /// Extra physics, flattened for the inner loop.
-struct Physics {
+///
+/// `EXTRAS = false` is the plain axis (no current loop, current lag, delay, cogging or
+/// scaled friction; springs and offsets are kept): the simulation loop is compiled once
+/// for it, with every test of the absent physics removed, and once for the general case.
+/// Both run the same code, so their results are identical.
+struct Physics<const EXTRAS: bool> {
     mass: f64,
     kf: f64,
     fr: LugreParams<f64>,
@@ -138,8 +143,20 @@ fn interp_clamped(xp: &[f64], fp: &[f64], x: f64) -> f64 {
     fp[j - 1] + (fp[j] - fp[j - 1]) * (x - x0) / (x1 - x0)
 }
 
-impl Physics {
+/// True when the model needs none of the extras of [`Physics`].
+fn is_plain(m: &Model) -> bool {
+    m.axis.current_loop.is_none()
+        && m.effects.iter().all(|e| {
+            matches!(
+                e,
+                Effect::Spring { .. } | Effect::Offset { .. } | Effect::Mass { .. }
+            )
+        })
+}
+
+impl<const EXTRAS: bool> Physics<EXTRAS> {
     fn new(m: &Model, t0: f64) -> Self {
+        debug_assert!(EXTRAS || is_plain(m));
         let mut p = Physics {
             mass: m.total_mass(),
             kf: m.axis.force_constant,
@@ -191,8 +208,35 @@ impl Physics {
     }
 
     #[inline(always)]
+    fn current_loop(&self) -> Option<&CurrentLoop> {
+        if EXTRAS {
+            self.current_loop.as_ref()
+        } else {
+            None
+        }
+    }
+
+    #[inline(always)]
+    fn lag_w(&self) -> Option<f64> {
+        if EXTRAS {
+            self.lag_w
+        } else {
+            None
+        }
+    }
+
+    #[inline(always)]
+    fn delay(&self) -> Option<f64> {
+        if EXTRAS {
+            self.delay
+        } else {
+            None
+        }
+    }
+
+    #[inline(always)]
     fn scale(&self, x: f64, time: f64) -> f64 {
-        if !self.has_scale {
+        if !(EXTRAS && self.has_scale) {
             return 1.0;
         }
         let mut s = 1.0;
@@ -208,8 +252,10 @@ impl Physics {
     #[inline(always)]
     fn effect_force(&self, x: f64) -> f64 {
         let mut f = self.lin_a * x + self.lin_b;
-        for &(a, w, ph) in &self.cogging {
-            f += a * (w * x + ph).sin();
+        if EXTRAS {
+            for &(a, w, ph) in &self.cogging {
+                f += a * (w * x + ph).sin();
+            }
         }
         f
     }
@@ -232,14 +278,52 @@ struct State {
     fl: f64,
 }
 
-impl Physics {
+/// The factors of the motor update that depend only on the step length `h`, computed
+/// once per interval between events rather than once per plant step (and only for the
+/// physics the model has: the compiler would otherwise hoist every `exp()` of
+/// [`Physics::motor`] out of the step loop and run them all at each event).
+#[derive(Debug, Clone, Copy)]
+struct MotorStep {
+    h: f64,
+    /// `exp(-2*pi*f*h)` of a first-order current loop.
+    current_decay: f64,
+    /// RK4 sub-steps of an R-L current loop.
+    rl_substeps: usize,
+    /// `exp(-2*pi*bw*h)` of the `current_lag` effect.
+    lag_decay: f64,
+}
+
+impl<const EXTRAS: bool> Physics<EXTRAS> {
+    fn motor_step(&self, h: f64) -> MotorStep {
+        let mut ms = MotorStep {
+            h,
+            current_decay: 0.0,
+            rl_substeps: 1,
+            lag_decay: 0.0,
+        };
+        match self.current_loop() {
+            None => {}
+            Some(CurrentLoop::FirstOrder { bandwidth_hz }) => {
+                ms.current_decay = (-2.0 * PI * bandwidth_hz * h).exp();
+            }
+            Some(CurrentLoop::Rl { inductance, kp, .. }) => {
+                let wc = kp / inductance;
+                ms.rl_substeps = ((h * wc * 4.0).ceil() as usize).max(1);
+            }
+        }
+        if let Some(w) = self.lag_w() {
+            ms.lag_decay = (-w * h).exp();
+        }
+        ms
+    }
+
     /// Advance the current (loop) and the lagged force over h; returns the motor force.
     #[inline(always)]
-    fn motor(&self, s: &mut State, ic: f64, h: f64) -> f64 {
-        match &self.current_loop {
+    fn motor(&self, s: &mut State, ic: f64, ms: &MotorStep) -> f64 {
+        match self.current_loop() {
             None => s.ia = ic,
-            Some(CurrentLoop::FirstOrder { bandwidth_hz }) => {
-                s.ia = ic + (s.ia - ic) * (-2.0 * PI * bandwidth_hz * h).exp();
+            Some(CurrentLoop::FirstOrder { .. }) => {
+                s.ia = ic + (s.ia - ic) * ms.current_decay;
             }
             Some(CurrentLoop::Rl {
                 resistance: r,
@@ -248,9 +332,8 @@ impl Physics {
                 kp,
                 ki,
             }) => {
-                let wc = kp / l;
-                let ns = ((h * wc * 4.0).ceil() as usize).max(1);
-                let hs = h / ns as f64;
+                let ns = ms.rl_substeps;
+                let hs = ms.h / ns as f64;
                 let v = s.v;
                 let d =
                     |ia: f64, q: f64| ((kp * (ic - ia) + ki * q - r * ia - ke * v) / l, ic - ia);
@@ -265,26 +348,28 @@ impl Physics {
             }
         }
         let fm = self.kf * s.ia;
-        match self.lag_w {
+        match self.lag_w() {
             None => fm,
-            Some(w) => {
-                s.fl = fm + (s.fl - fm) * (-w * h).exp();
+            Some(_) => {
+                s.fl = fm + (s.fl - fm) * ms.lag_decay;
                 s.fl
             }
         }
     }
 
     #[inline(always)]
-    fn step_exact(&self, s: &mut State, ic: f64, h: f64, time: f64) {
-        let fm = self.motor(s, ic, h);
+    fn step_exact(&self, s: &mut State, ic: f64, ms: &MotorStep, time: f64) {
+        let h = ms.h;
+        let fm = self.motor(s, ic, ms);
         let (a, g, _) = self.accel(fm, s.x, s.v, s.z, time);
         s.z = self.fr.advance_z(s.z, s.v, g, h);
         s.v += a * h;
         s.x += s.v * h;
     }
 
-    fn step_rk4(&self, s: &mut State, ic: f64, h: f64, time: f64) {
-        let fm = self.motor(s, ic, h);
+    fn step_rk4(&self, s: &mut State, ic: f64, ms: &MotorStep, time: f64) {
+        let h = ms.h;
+        let fm = self.motor(s, ic, ms);
         let d = |x: f64, v: f64, z: f64, tm: f64| {
             let (a, _, zdot) = self.accel(fm, x, v, z, tm);
             (v, a, zdot)
@@ -393,9 +478,24 @@ pub fn simulate(
     keep_going: &mut dyn FnMut() -> bool,
 ) -> Result<SimResult> {
     check_inputs(model, t, &drive, opts)?;
+    if is_plain(model) {
+        run(model, t, drive, opts, keep_going, &Physics::<false>::new(model, t[0]))
+    } else {
+        run(model, t, drive, opts, keep_going, &Physics::<true>::new(model, t[0]))
+    }
+}
+
+/// The event loop of [`simulate`] (`docs/DESIGN.md`), on checked inputs.
+fn run<const EXTRAS: bool>(
+    model: &Model,
+    t: &[f64],
+    drive: Drive,
+    opts: &SimOptions,
+    keep_going: &mut dyn FnMut() -> bool,
+    phys: &Physics<EXTRAS>,
+) -> Result<SimResult> {
     let n_out = t.len();
     let t0 = t[0];
-    let phys = Physics::new(model, t0);
     let open_loop = matches!(drive, Drive::Current(_));
     let (rate, ctrl) = match (&model.controller, open_loop) {
         (Some(c), false) => (c.rate_hz, Some(c)),
@@ -494,7 +594,7 @@ pub fn simulate(
             } else {
                 ic = reference[n];
             }
-            match phys.delay {
+            match phys.delay() {
                 None => ic_eff = ic,
                 Some(d) => queue.push_back((tc + d, ic)),
             }
@@ -514,21 +614,21 @@ pub fn simulate(
             out.x.push(s.x);
             out.v.push(s.v);
             out.z.push(s.z);
-            out.i.push(if phys.current_loop.is_some() {
+            out.i.push(if phys.current_loop().is_some() {
                 s.ia
             } else {
                 ic
             });
             out.friction.push(f);
             let fm = phys.kf
-                * if phys.current_loop.is_some() {
+                * if phys.current_loop().is_some() {
                     s.ia
-                } else if phys.delay.is_some() {
+                } else if phys.delay().is_some() {
                     ic_eff_peek(&queue, ic_eff, time, tol)
                 } else {
                     ic_eff
                 };
-            out.force.push(match phys.lag_w {
+            out.force.push(match phys.lag_w() {
                 Some(_) => s.fl,
                 None => fm,
             });
@@ -538,11 +638,19 @@ pub fn simulate(
             break;
         }
         let next = tc.min(t[k]);
-        let m = (((next - time) / h_max - 1e-6).ceil() as usize).max(1);
+        // max(1, ceil(span/h_max - 1e-6)) plant steps; one in the usual case, without
+        // the call to ceil() (a libm call on baseline x86-64)
+        let r = (next - time) / h_max - 1e-6;
+        let m = if r <= 1.0 {
+            1
+        } else {
+            (r.ceil() as usize).max(1)
+        };
         let h = (next - time) / m as f64;
+        let ms = phys.motor_step(h);
         for j in 0..m {
             let tj = time + j as f64 * h;
-            if phys.delay.is_some() {
+            if phys.delay().is_some() {
                 while let Some(&(te, val)) = queue.front() {
                     if te <= tj + tol {
                         ic_eff = val;
@@ -553,8 +661,8 @@ pub fn simulate(
                 }
             }
             match opts.integrator {
-                Integrator::Exact => phys.step_exact(&mut s, ic_eff, h, tj),
-                Integrator::Rk4 => phys.step_rk4(&mut s, ic_eff, h, tj),
+                Integrator::Exact => phys.step_exact(&mut s, ic_eff, &ms, tj),
+                Integrator::Rk4 => phys.step_rk4(&mut s, ic_eff, &ms, tj),
             }
         }
         if !(s.x.is_finite() && s.v.is_finite() && s.z.is_finite()) {
