@@ -308,6 +308,7 @@ def forward_select(
         chosen = {t.effect for t in terms}
         superseded = {s for t in terms for s in t.cand.supersedes}
         best = None
+        okays: dict[str, tuple[Any, ...]] = {}
         for c in cands:
             if c.effect in chosen or c.effect in superseded:
                 continue
@@ -338,8 +339,20 @@ def forward_select(
                         "accepted": False, "ok": ok, "why": why})
             if ok and (best is None or evid["gain"] > best[0]):
                 best = (evid["gain"], trial, ev, len(log) - 1)
+            if ok:
+                okays[c.effect] = (evid["gain"], trial, ev, len(log) - 1, c)
         if best is None:
             break
+        # parsimony: a term that contains a simpler one (spring contains offset) must
+        # pass the same test against it, or the simpler story is told
+        bc = okays.get(log[best[3]]["effect"])
+        for simple in (bc[4].supersedes if bc else ()):
+            if simple in okays:
+                nested = compare(okays[simple][2], best[2], s2)
+                if not accept(nested, alpha=alpha, min_gain=min_gain)[0]:
+                    best = okays[simple][:4]
+                    log[best[3]]["why"] += ("; preferred to a term containing it, which "
+                                            "does not pass the test against it (parsimony)")
         _, terms, cur, li = best
         log[li]["accepted"] = True
     return terms, cur, log
