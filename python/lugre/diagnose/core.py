@@ -100,6 +100,51 @@ def _offset_alternative(scorer: Scorer, terms: list[Term], ev: Any, names: list[
     }, txt
 
 
+def _drift_identifiability(term: Term, T: float, thr: float = 10.0
+                           ) -> tuple[dict[str, Any], str]:
+    """What a record determines of a drift: intervals from the held-out profile over tau.
+
+    Over a record short against the time constant, gain and time constant trade off and
+    only the change over the record (a trend) is determined. The interval is the set of
+    time constants whose held-out score lies within ``thr`` of the best (the selection
+    threshold on the coloured chi-square scale, at the resolution of the grid); the time
+    constant counts as determined when that interval closes inside the record.
+    """
+    pr = term.profile
+    if pr is None:
+        return {}, ""
+    h, sc, beta = pr["h"], pr["score"], pr["beta"]
+    ok = sc <= sc.min() + thr
+    g = -beta[ok, 0]
+    taus = h[ok]
+    lo, hi = float(taus.min()), float(taus.max())
+    open_hi = hi >= 0.999 * pr["grid_max"]
+    open_lo = lo <= 1.001 * pr["grid_min"]
+    determined = not open_hi and not open_lo and hi <= T
+    rate = g / taus
+    total = g * (1.0 - np.exp(-T / taus))
+    unc = {"time_constant": [lo, None if open_hi else hi],
+           "gain": [float(g.min()), float(g.max())],
+           "initial_rate_per_s": [float(rate.min()), float(rate.max())],
+           "change_over_record": [float(total.min()), float(total.max())],
+           "mean_rate_per_s": [float(total.min() / T), float(total.max() / T)],
+           "time_constant_determined": bool(determined),
+           "criterion": f"held-out score within {thr:g} of the best"}
+    if not determined:
+        txt = (f"Over the {T:.3g} s record the Coulomb/static level falls by "
+               f"{100 * total.min():.2g} to {100 * total.max():.2g} % "
+               f"({100 * total.min() / T:.2g} to {100 * total.max() / T:.2g} %/s on average); "
+               f"the time constant is not determined (from {lo:.3g} s to "
+               f"{'beyond the grid' if open_hi else f'{hi:.3g} s'}: gain and time constant "
+               "trade off), the pair reported is the best on the grid.")
+    else:
+        txt = (f"Time constant {lo:.3g} to {hi:.3g} s and gain {g.min():.3g} to "
+               f"{g.max():.3g} fit within {thr:g} of the best held-out score; the level "
+               f"falls by {100 * total.min():.2g} to {100 * total.max():.2g} % over the "
+               "record.")
+    return unc, txt
+
+
 def _rest_evidence(sig: R.Signals, min_s: float = 0.2) -> str:
     """Mean motor force in stretches at rest (entered from either side), if any."""
     still = (sig.v == 0.0) & sig.mask
@@ -480,6 +525,10 @@ def diagnose(
             j = int(np.argmax(np.abs(sc - 1)))
             extra = (f"Largest change x{sc[j]:.3g} of the Coulomb/static level at "
                      f"x = {e0['positions'][j]:.4g} m.")
+        unc: dict[str, Any] = {}
+        if t.effect == "drift":
+            unc, extra = _drift_identifiability(t, float(sig.t[sig.mask][-1]),
+                                                thr=min_gain)
         if t.effect == "offset":
             alt_off, extra = _offset_alternative(scorer, terms, ev_sel, names, tol, model,
                                                  sig, min_gain)
@@ -489,7 +538,7 @@ def diagnose(
                     parameters={a: v for a, v in e0.items() if a != "effect"},
                     where=t.cand.where(t.h, betas[k], ctx), explained=expl,
                     evidence=_evidence(t, lg, blocks, extra),
-                    alternatives=alternatives.get(k, []))
+                    alternatives=alternatives.get(k, []), uncertainty=unc)
         findings.append(f)
         for e in effs[1:]:  # e.g. a spring whose x0 cannot be placed: offset beside it
             findings.append(Finding(effect=e["effect"],
