@@ -87,6 +87,7 @@ struct Interp<'a> {
 }
 
 impl<'a> Interp<'a> {
+    #[inline(always)]
     fn at(&mut self, tq: f64) -> f64 {
         let n = self.t.len();
         if tq <= self.t[0] {
@@ -478,15 +479,28 @@ pub fn simulate(
     keep_going: &mut dyn FnMut() -> bool,
 ) -> Result<SimResult> {
     check_inputs(model, t, &drive, opts)?;
-    if is_plain(model) {
-        run(model, t, drive, opts, keep_going, &Physics::<false>::new(model, t[0]))
-    } else {
-        run(model, t, drive, opts, keep_going, &Physics::<true>::new(model, t[0]))
+    // one instance of the event loop per kind of physics and integrator
+    let plain = is_plain(model);
+    let t0 = t[0];
+    match (plain, opts.integrator) {
+        (true, Integrator::Exact) => {
+            run::<false, false>(model, t, drive, opts, keep_going, &Physics::new(model, t0))
+        }
+        (true, Integrator::Rk4) => {
+            run::<false, true>(model, t, drive, opts, keep_going, &Physics::new(model, t0))
+        }
+        (false, Integrator::Exact) => {
+            run::<true, false>(model, t, drive, opts, keep_going, &Physics::new(model, t0))
+        }
+        (false, Integrator::Rk4) => {
+            run::<true, true>(model, t, drive, opts, keep_going, &Physics::new(model, t0))
+        }
     }
 }
 
-/// The event loop of [`simulate`] (`docs/DESIGN.md`), on checked inputs.
-fn run<const EXTRAS: bool>(
+/// The event loop of [`simulate`] (`docs/DESIGN.md`) on checked inputs, for the
+/// physics `EXTRAS` (see [`Physics`]) and the RK4 (`RK4`) or exact integrator.
+fn run<const EXTRAS: bool, const RK4: bool>(
     model: &Model,
     t: &[f64],
     drive: Drive,
@@ -558,7 +572,8 @@ fn run<const EXTRAS: bool>(
                 f64::INFINITY
             }
         } else {
-            t0 + n as f64 / rate
+            // n < 2^53: the signed conversion is exact and one instruction
+            t0 + n as i64 as f64 / rate
         }
     };
     let mut tc = ctrl_time(0);
@@ -646,7 +661,11 @@ fn run<const EXTRAS: bool>(
         } else {
             (r.ceil() as usize).max(1)
         };
-        let h = (next - time) / m as f64;
+        let h = if m == 1 {
+            next - time
+        } else {
+            (next - time) / m as f64
+        };
         let ms = phys.motor_step(h);
         for j in 0..m {
             let tj = time + j as f64 * h;
@@ -660,9 +679,10 @@ fn run<const EXTRAS: bool>(
                     }
                 }
             }
-            match opts.integrator {
-                Integrator::Exact => phys.step_exact(&mut s, ic_eff, &ms, tj),
-                Integrator::Rk4 => phys.step_rk4(&mut s, ic_eff, &ms, tj),
+            if RK4 {
+                phys.step_rk4(&mut s, ic_eff, &ms, tj);
+            } else {
+                phys.step_exact(&mut s, ic_eff, &ms, tj);
             }
         }
         if !(s.x.is_finite() && s.v.is_finite() && s.z.is_finite()) {
