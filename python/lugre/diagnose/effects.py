@@ -16,8 +16,8 @@ candidate                 signature (column)
                           position
 ``position_friction``     hat functions of position times the Coulomb/static part of the
                           friction (the sign follows the direction of motion)
-``drift``                 ``(1 - exp(-t/tau))`` times the Coulomb/static part, ``tau`` from a
-                          grid
+``drift``                 ``(1 - exp(-t/tau))`` times the Coulomb/static part, ``tau`` by the
+                          held-out score of the joint fit over a grid (profile)
 ``delay``/``current_lag`` time derivative of the motor force (a lag against the command);
                           the two are told apart afterwards by their exact forms
 ========================  =================================================================
@@ -215,6 +215,11 @@ class Candidate:
         """Pick the nonlinear parameter against the current residual ``r`` (filtered)."""
         return None
 
+    def grid(self, ctx: Context) -> np.ndarray | None:
+        """Values of the nonlinear parameter to profile by the held-out score of the
+        joint fit (``None``: :meth:`choose` picks it)."""
+        return None
+
     def columns(self, h: Any, ctx: Context) -> np.ndarray:
         """Filtered regressors ``(n, p)``."""
         raise NotImplementedError
@@ -384,16 +389,10 @@ class Drift(Candidate):
     def _col(self, tau: float, ctx: Context) -> np.ndarray:
         return (1.0 - np.exp(-ctx.sig.t / tau)) * ctx.fcs
 
-    def choose(self, r: np.ndarray, ctx: Context) -> Any:
-        m = ctx.sig.mask
-        best, bt = -1.0, None
-        for tau in self._grid(ctx):
-            c = ctx.sig.filt(self._col(tau, ctx))[m]
-            c = c - c.mean()
-            p = (c @ (r[m] - r[m].mean())) ** 2 / max(c @ c, 1e-30)
-            if p > best:
-                best, bt = p, float(tau)
-        return bt
+    def grid(self, ctx: Context) -> np.ndarray | None:
+        # tau is chosen with the base levels re-fitted alongside (a level shift and a
+        # slow trend trade off), by the held-out score over this grid
+        return self._grid(ctx)
 
     def columns(self, h: Any, ctx: Context) -> np.ndarray:
         return ctx.sig.filt(self._col(h, ctx))[:, None]

@@ -32,6 +32,9 @@ class Finding:
         One or two sentences a person can check.
     alternatives : list of dict
         Explanations that fit equally well, with the experiment that separates them.
+    uncertainty : dict
+        What the record determines of the parameters (intervals; for ``drift`` the
+        time constant, the gain, the initial rate and the change over the record).
     """
 
     effect: str
@@ -40,6 +43,7 @@ class Finding:
     explained: float
     evidence: str
     alternatives: list[dict[str, Any]] = field(default_factory=list)
+    uncertainty: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         """The CONTRACT form (plus ``alternatives`` when there are any)."""
@@ -52,6 +56,8 @@ class Finding:
         }
         if self.alternatives:
             d["alternatives"] = _plain(self.alternatives)
+        if self.uncertainty:
+            d["uncertainty"] = _plain(self.uncertainty)
         return d
 
 
