@@ -9,13 +9,18 @@
 //! hold by construction.
 //!
 //! Start values need no user input: for a fixed `vs` the curve is linear in
-//! `(fc, fs, sigma2)`, so a grid over `ln vs` with a robust (Huber) linear fit at each
-//! node, scored by the median absolute residual, gives a start that gross errors do not
-//! pull away (a variable-projection start, Golub and Pereyra 1973).
+//! `(fc, fs, sigma2)`, so a grid over `ln vs` with a robust linear fit at each node
+//! gives a start that gross errors do not pull away (a variable-projection start,
+//! Golub and Pereyra 1973). With a rejecting weight function (IGG, Tukey) two such
+//! starts are followed to the end, a Huber grid and a least-trimmed-squares grid (the
+//! latter also resists gross errors at the fastest or slowest speeds, which have high
+//! leverage), and the fit with the smaller bounded loss is returned; the
+//! kept points are then refitted by plain least squares, with the rejections
+//! re-checked, which recovers the efficiency the down-weighting band costs.
 
-use super::irls::{irls, IrlsSetup};
-use super::nelder_mead::NmOptions;
-use super::robust::{median, t_quantile_975, Weighting};
+use super::irls::{irls, IrlsOutcome, IrlsSetup};
+use super::nelder_mead::{minimize, NmOptions};
+use super::robust::{median, robust_scale, t_quantile_975, Weighting};
 use crate::error::{check_finite, check_len, Error, Result};
 use crate::friction::StaticSet;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
@@ -42,6 +47,11 @@ pub struct StaticFitOptions {
     pub scale_floor: f64,
     /// Objective evaluations per Nelder-Mead run.
     pub max_evals: usize,
+    /// With a rejecting weight function (IGG, Tukey): after IRLS, refit by plain least
+    /// squares on the points it kept, then re-check the rejections at the robust scale
+    /// and repeat until the kept set settles (true by default). The down-weighting band
+    /// of IGG costs efficiency on clean Gaussian points; this recovers it.
+    pub refit_kept: bool,
 }
 
 impl Default for StaticFitOptions {
@@ -52,6 +62,7 @@ impl Default for StaticFitOptions {
             tol: 1e-7,
             scale_floor: 0.0,
             max_evals: 4000,
+            refit_kept: true,
         }
     }
 }
@@ -139,8 +150,120 @@ fn linear_fit(a: &[f64], y: &[f64], w: &[f64], vs: f64) -> Option<Vector3<f64>> 
     x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
-/// Start values `(fc, fs, sigma2, vs)` from the `ln vs` grid.
-fn start_values(a: &[f64], y: &[f64]) -> [f64; 4] {
+/// Least trimmed squares of `y = fc*(1 - phi) + fs*phi + s2*a` for fixed `vs`: the
+/// three coefficients minimising the sum of the `h` smallest squared residuals,
+/// by concentration steps (Rousseeuw and Van Driessen 2006) from elemental starts.
+/// Returns the coefficients and that trimmed sum.
+fn lts_linear(
+    a: &[f64],
+    y: &[f64],
+    vs: f64,
+    h: usize,
+    seeds: &[[usize; 3]],
+) -> Option<(Vector3<f64>, f64)> {
+    let n = a.len();
+    let mut w = vec![0.0; n];
+    let mut r2 = vec![0.0; n];
+    let mut order: Vec<usize> = (0..n).collect();
+    // one concentration step: keep the h points nearest to the curve of x, refit
+    let mut cstep = |x: &Vector3<f64>, w: &mut Vec<f64>| -> Option<(Vector3<f64>, f64)> {
+        for i in 0..n {
+            let e = y[i] - curve(&[x[0], x[1], x[2], vs], a[i]);
+            r2[i] = e * e;
+        }
+        order.sort_unstable_by(|&p, &q| r2[p].total_cmp(&r2[q]));
+        let before: f64 = order[..h].iter().map(|&i| r2[i]).sum();
+        w.iter_mut().for_each(|v| *v = 0.0);
+        for &i in &order[..h] {
+            w[i] = 1.0;
+        }
+        Some((linear_fit(a, y, w, vs)?, before))
+    };
+    let trimmed = |x: &Vector3<f64>| -> f64 {
+        let mut e: Vec<f64> = (0..n)
+            .map(|i| (y[i] - curve(&[x[0], x[1], x[2], vs], a[i])).powi(2))
+            .collect();
+        e.sort_unstable_by(|p, q| p.total_cmp(q));
+        e[..h].iter().sum()
+    };
+    let mut cands: Vec<(f64, Vector3<f64>)> = Vec::new();
+    // the plain least-squares fit and elemental fits through three points, two
+    // concentration steps each
+    let mut starts = Vec::with_capacity(seeds.len() + 1);
+    starts.push(linear_fit(a, y, &vec![1.0; n], vs));
+    for sd in seeds {
+        w.iter_mut().for_each(|v| *v = 0.0);
+        for &i in sd {
+            w[i] = 1.0;
+        }
+        starts.push(linear_fit(a, y, &w, vs));
+    }
+    for x0 in starts.into_iter().flatten() {
+        let mut x = x0;
+        for _ in 0..2 {
+            match cstep(&x, &mut w) {
+                Some((xn, _)) => x = xn,
+                None => break,
+            }
+        }
+        let obj = trimmed(&x);
+        if obj.is_finite() {
+            cands.push((obj, x));
+        }
+    }
+    cands.sort_by(|p, q| p.0.total_cmp(&q.0));
+    // the best few to convergence
+    let mut best: Option<(Vector3<f64>, f64)> = None;
+    for (_, x0) in cands.into_iter().take(4) {
+        let mut x = x0;
+        let mut obj = trimmed(&x);
+        for _ in 0..20 {
+            let Some((xn, _)) = cstep(&x, &mut w) else {
+                break;
+            };
+            let on = trimmed(&xn);
+            if !(on < obj * (1.0 - 1e-12)) {
+                if on <= obj {
+                    x = xn;
+                    obj = on;
+                }
+                break;
+            }
+            x = xn;
+            obj = on;
+        }
+        if best.as_ref().is_none_or(|b| obj < b.1) {
+            best = Some((x, obj));
+        }
+    }
+    best
+}
+
+/// Elemental subsets (three distinct indices below `n`) from a fixed-seed generator,
+/// so that fits are reproducible.
+fn elemental_seeds(n: usize, count: usize) -> Vec<[usize; 3]> {
+    let mut state = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) % n as u64) as usize
+    };
+    let mut out = Vec::with_capacity(count);
+    while out.len() < count && n >= 3 {
+        let (i, j, k) = (next(), next(), next());
+        if i != j && j != k && i != k {
+            out.push([i, j, k]);
+        }
+    }
+    out
+}
+
+/// Start values `(fc, fs, sigma2, vs)` from the `ln vs` grid (Huber).
+///
+/// At each node a Huber IRLS linear fit, scored by the median absolute residual.
+fn start_values_huber(a: &[f64], y: &[f64]) -> [f64; 4] {
     let amin = a.iter().copied().fold(f64::INFINITY, f64::min);
     let amax = a.iter().copied().fold(0.0, f64::max);
     let fscale = median(&y.iter().map(|v| v.abs()).collect::<Vec<_>>()).max(1e-12);
@@ -161,7 +284,7 @@ fn start_values(a: &[f64], y: &[f64]) -> [f64; 4] {
                 .zip(y)
                 .map(|(&ai, &yi)| yi - curve(&[x[0], x[1], x[2], vs], ai))
                 .collect();
-            let s = super::robust::robust_scale(&e).max(1e-12 * fscale);
+            let s = robust_scale(&e).max(1e-12 * fscale);
             w = huber.weights(&e, s);
             match linear_fit(a, y, &w, vs) {
                 Some(xn) => x = xn,
@@ -190,6 +313,97 @@ fn start_values(a: &[f64], y: &[f64]) -> [f64; 4] {
     p
 }
 
+/// Start values `(fc, fs, sigma2, vs)` from the `ln vs` grid (least trimmed squares).
+///
+/// At each node the curve is linear in `(fc, fs, sigma2)`; a least-trimmed-squares
+/// fit there (on three quarters of the points) resists gross errors also at the ends of
+/// the speed range, where a single point has high leverage on `sigma2` and `fc` and
+/// a monotone M-estimate (Huber) follows it. The node with the smallest trimmed sum
+/// gives the start: the high-breakdown first stage of an MM-estimate (Yohai 1987).
+fn start_values_lts(a: &[f64], y: &[f64]) -> [f64; 4] {
+    let amin = a.iter().copied().fold(f64::INFINITY, f64::min);
+    let amax = a.iter().copied().fold(0.0, f64::max);
+    let fscale = median(&y.iter().map(|v| v.abs()).collect::<Vec<_>>()).max(1e-12);
+    let n = a.len();
+    let h = ((3 * n + 3) / 4).min(n);
+    let seeds = elemental_seeds(n, 30);
+    let mut best: Option<(f64, [f64; 4])> = None;
+    let ngrid = 41;
+    let (lo, hi) = ((amin * 0.5).ln(), (amax * 2.0).ln());
+    for k in 0..ngrid {
+        let vs = (lo + (hi - lo) * k as f64 / (ngrid - 1) as f64).exp();
+        let Some((x, score)) = lts_linear(a, y, vs, h, &seeds) else {
+            continue;
+        };
+        let p = [x[0], x[1], x[2], vs];
+        if score.is_finite() && best.is_none_or(|(b, _)| score < b) {
+            best = Some((score, p));
+        }
+    }
+    let mut p = best
+        .map(|b| b.1)
+        .unwrap_or([fscale, 1.5 * fscale, 0.0, amax]);
+    // keep inside the parametrisation (all positive, fs > fc)
+    p[0] = p[0].max(1e-3 * fscale);
+    p[1] = p[1].max(p[0] * 1.01 + 1e-6 * fscale);
+    p[2] = p[2].max(1e-6 * fscale / amax.max(1e-300));
+    p[3] = p[3].clamp(amin * 0.5, amax * 2.0);
+    p
+}
+
+/// Least squares on the points IRLS kept, re-checking the rejections (`|e| > k1*s`,
+/// `s` the robust scale of all residuals at the refit) until the kept set settles.
+fn refit_kept(
+    resid: &dyn Fn(&[f64]) -> Option<Vec<f64>>,
+    objective: &dyn Fn(&[f64], &[f64]) -> f64,
+    out: &mut IrlsOutcome,
+    k1: f64,
+    setup: &IrlsSetup,
+) {
+    let mut keep: Vec<f64> = out
+        .weights
+        .iter()
+        .map(|w| if *w > 0.0 { 1.0 } else { 0.0 })
+        .collect();
+    let step: Vec<f64> = setup.step.iter().map(|s| 0.1 * s).collect();
+    for _ in 0..5 {
+        if keep.iter().sum::<f64>() < MIN_POINTS_PER_DIRECTION as f64 {
+            return;
+        }
+        let mut f = |th: &[f64]| match resid(th) {
+            Some(r) => objective(&r, &keep),
+            None => f64::INFINITY,
+        };
+        let r = minimize(&mut f, &out.theta, &step, &setup.nm);
+        out.evals += r.evals + 1;
+        let Some(e) = resid(&r.x) else {
+            return;
+        };
+        // scale of the kept points (n_kept - 4 degrees of freedom), made consistent for
+        // a Gaussian truncated at +-k1: more efficient than the MAD of all residuals,
+        // whose noise in a small sample moves the rejection threshold
+        let n_kept = keep.iter().sum::<f64>();
+        let ss: f64 = e.iter().zip(&keep).map(|(ei, wi)| wi * ei * ei).sum();
+        let phi = (-0.5 * k1 * k1).exp() / (2.0 * std::f64::consts::PI).sqrt();
+        let var_factor = 1.0 - 2.0 * k1 * phi / libm::erf(k1 / std::f64::consts::SQRT_2);
+        let s = (ss / (n_kept - 4.0) / var_factor)
+            .sqrt()
+            .max(setup.scale_floor);
+        let new_keep: Vec<f64> = e
+            .iter()
+            .map(|ei| if ei.abs() <= k1 * s { 1.0 } else { 0.0 })
+            .collect();
+        out.theta = r.x;
+        out.residuals = e;
+        out.scale = s;
+        out.weights = keep.clone();
+        if new_keep == keep {
+            return;
+        }
+        keep = new_keep;
+    }
+}
+
 /// Fit one direction to magnitudes `a = |v|` and mirrored forces `y = sign(v)*F`.
 fn fit_direction(
     a: &[f64],
@@ -200,8 +414,7 @@ fn fit_direction(
     notes: &mut Vec<String>,
     label: &str,
 ) -> Result<DirectionFit> {
-    let p0 = start_values(a, y);
-    let theta0 = vec![p0[0].ln(), (p0[1] - p0[0]).ln(), p0[2].ln(), p0[3].ln()];
+    let to_theta = |p: [f64; 4]| vec![p[0].ln(), (p[1] - p[0]).ln(), p[2].ln(), p[3].ln()];
     let resid = |th: &[f64]| -> Option<Vec<f64>> {
         let p = to_params(th);
         if !p.iter().all(|v| v.is_finite() && *v > 0.0) {
@@ -231,24 +444,71 @@ fn fit_direction(
         },
         step: &step,
     };
-    // Redescending weights (IGG, Tukey) can settle on a wrong set of rejected points
-    // when started far out; a Huber pass first (monotone, unique fixed point) gives
-    // them a start near the answer, as in MM-estimation (Yohai 1987).
-    let theta0 = if matches!(
-        opts.weighting,
-        Weighting::Igg { .. } | Weighting::Tukey { .. }
-    ) {
-        let pre = IrlsSetup {
-            weighting: Weighting::huber(),
-            ..setup
-        };
-        irls(&resid, &objective, theta0.clone(), &pre)
-            .map(|o| o.theta)
-            .unwrap_or(theta0)
-    } else {
-        theta0
+    let reject_at = match opts.weighting {
+        Weighting::Igg { k1, .. } => Some(k1),
+        Weighting::Tukey { c } => Some(c),
+        _ => None,
     };
-    let out = irls(&resid, &objective, theta0, &setup).ok_or_else(|| {
+    // One path: from a start, an optional IRLS pass with another weight function,
+    // IRLS, then (rejecting weight functions) the least-squares refit on the kept points.
+    let path = |p0: [f64; 4], pre: Option<Weighting>| -> Option<IrlsOutcome> {
+        let mut theta0 = to_theta(p0);
+        let mut evals = 0;
+        if let Some(w) = pre {
+            let pre = IrlsSetup {
+                weighting: w,
+                ..setup
+            };
+            if let Some(o) = irls(&resid, &objective, theta0.clone(), &pre) {
+                theta0 = o.theta;
+                evals = o.evals;
+            }
+        }
+        let mut out = irls(&resid, &objective, theta0, &setup)?;
+        out.evals += evals;
+        if let (true, Some(k1)) = (opts.refit_kept, reject_at) {
+            refit_kept(&resid, &objective, &mut out, k1, &setup);
+        }
+        Some(out)
+    };
+    let out = if reject_at.is_some() {
+        // Redescending weights (IGG, Tukey) settle on the set of rejected points near
+        // their start. Two starts, as in MM-estimation (Yohai 1987): (a) a Huber pass
+        // (monotone, unique fixed point) from the Huber grid; (b) a Tukey pass from the
+        // least-trimmed-squares grid, which also resists gross errors of high leverage
+        // (the fastest and slowest points) that a Huber fit follows. The fit with the
+        // smaller bounded (Tukey) loss at a common scale wins, as in the choice among
+        // local minima of an MM-estimate.
+        let a_fit = path(start_values_huber(a, y), Some(Weighting::huber()));
+        let b_fit = path(start_values_lts(a, y), Some(Weighting::tukey()));
+        match (a_fit, b_fit) {
+            (Some(fa), Some(fb)) => {
+                // Tukey's rho at a common scale (the smaller robust scale of the two):
+                // a rejected point costs the same in both, a kept one its misfit
+                let s = robust_scale(&fa.residuals)
+                    .min(robust_scale(&fb.residuals))
+                    .max(setup.scale_floor);
+                let c = 4.685;
+                let rho = |o: &IrlsOutcome| -> f64 {
+                    o.residuals
+                        .iter()
+                        .map(|e| {
+                            let u = (e / (c * s)).abs().min(1.0);
+                            1.0 - (1.0 - u * u).powi(3)
+                        })
+                        .sum()
+                };
+                let evals = fa.evals + fb.evals;
+                let mut best = if rho(&fb) < rho(&fa) { fb } else { fa };
+                best.evals = evals;
+                Some(best)
+            }
+            (fa, fb) => fa.or(fb),
+        }
+    } else {
+        path(start_values_huber(a, y), None)
+    };
+    let out = out.ok_or_else(|| {
         Error::Data(format!(
             "{label} direction: the Stribeck curve could not be evaluated at the start values; check the data for extreme values"
         ))
