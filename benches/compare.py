@@ -40,9 +40,8 @@ import time
 from pathlib import Path
 from typing import Any, Callable
 
-import numpy as np
-
 import lugre
+import numpy as np
 from lugre import reference
 
 HERE = Path(__file__).resolve().parent
@@ -178,10 +177,10 @@ def ivp_closed_loop(t: np.ndarray, xr_in: np.ndarray, periods: int, method: str,
     fr = MODEL.to_dict()["friction"]
     sets = {True: tuple(fr["positive"][k] for k in ("fc", "fs", "sigma2", "vs")),
             False: tuple(fr["negative"][k] for k in ("fc", "fs", "sigma2", "vs"))}
-    s0, s1, mass, kf = fr["sigma0"], fr["sigma1"], 25.0, 25.0
+    s0, s1, mass = fr["sigma0"], fr["sigma1"], 25.0
 
     def rhs(_t: float, y: np.ndarray, fm: float) -> list[float]:
-        x, v, z = y
+        _, v, z = y
         fc, fs, s2, vs = sets[v >= 0.0]
         g = fc + (fs - fc) * math.exp(-((v / vs) ** 2))
         zdot = v - s0 * abs(v) * z / g
@@ -255,8 +254,8 @@ def closed_loop(quick: bool) -> None:
     print(f"  (solve_ivp: {periods} control periods; lugre's own step error against "
           f"substeps=256: {err_own:.1e} m)")
     for method in ("LSODA", "Radau"):
-        tiv, xs = best(lambda: ivp_closed_loop(t_i, xr_i, periods, method, 1e-7,
-                                               [1e-9, 1e-7, 1e-12]), 1)
+        tiv, xs = best(lambda m=method: ivp_closed_loop(t_i, xr_i, periods, m, 1e-7,
+                                                        [1e-9, 1e-7, 1e-12]), 1)
         err = np.max(np.abs(xs - conv))
         row(f"solve_ivp {method} (rtol 1e-7)", periods / tiv, rate_lugre,
             f"error {err:.1e} m")
@@ -306,28 +305,26 @@ def static_points(n: int) -> tuple[np.ndarray, np.ndarray]:
     return v, f
 
 
-def static_fit(quick: bool) -> None:
+def scipy_static_fit(v: np.ndarray, f: np.ndarray) -> list[np.ndarray]:
+    """Stribeck parameters (fc, fs, sigma2, vs) per direction by least_squares with
+    the robust soft-L1 loss."""
     from scipy.optimize import least_squares
 
+    def res(p: np.ndarray, a: np.ndarray, y: np.ndarray) -> np.ndarray:
+        fc, fs, s2, vs = p
+        return fc + (fs - fc) * np.exp(-((a / vs) ** 2)) + s2 * a - y
+
+    return [least_squares(res, [20.0, 50.0, 100.0, 0.02], loss="soft_l1", f_scale=1.0,
+                          bounds=(1e-9, np.inf), args=(np.abs(v[sel]), np.abs(f[sel]))).x
+            for sel in (v > 0, v < 0)]
+
+
+def static_fit(quick: bool) -> None:
     print("\nstatic (Stribeck) fit, both directions (time per fit)")
     for n in (20, 100) if quick else (20, 100, 1000):
         v, f = static_points(n)
-        tl, fit = best(lambda: lugre.fit_static(v, f), 5)
-
-        def scipy_fit() -> list[np.ndarray]:
-            out = []
-            for sel in (v > 0, v < 0):
-                a, y = np.abs(v[sel]), np.abs(f[sel])
-
-                def res(p: np.ndarray) -> np.ndarray:
-                    fc, fs, s2, vs = p
-                    return fc + (fs - fc) * np.exp(-(a / vs) ** 2) + s2 * a - y
-
-                out.append(least_squares(res, [20.0, 50.0, 100.0, 0.02], loss="soft_l1",
-                                         f_scale=1.0, bounds=(1e-9, np.inf)).x)
-            return out
-
-        ts, ps = best(scipy_fit, 5)
+        tl, fit = best(lambda v=v, f=f: lugre.fit_static(v, f), 5)
+        ts, ps = best(lambda v=v, f=f: scipy_static_fit(v, f), 5)
         print(f"  {2 * n:5d} points: lugre {tl * 1e3:8.3f} ms (IGG IRLS, fs+ "
               f"{fit.positive.params['fs']:.2f}); least_squares soft_l1 {ts * 1e3:8.3f} ms "
               f"(fs+ {ps[0][1]:.2f}); ratio {ts / tl:.1f}x")
