@@ -623,18 +623,12 @@ fn run<const EXTRAS: bool, const RK4: bool>(
                 }
             }
         }
-        while k < n_out && t[k] <= time + tol {
+        if k < n_out && t[k] <= time + tol {
+            // Record the samples due now. The friction is evaluated here, under this
+            // test: inside the loop below, the compiler would hoist the evaluation (an
+            // exp()) out of it and run it at every event, sample or not.
             let sc = phys.scale(s.x, time);
             let (_, f, _) = phys.fr.eval(s.z, s.v, sc);
-            out.x.push(s.x);
-            out.v.push(s.v);
-            out.z.push(s.z);
-            out.i.push(if phys.current_loop().is_some() {
-                s.ia
-            } else {
-                ic
-            });
-            out.friction.push(f);
             let fm = phys.kf
                 * if phys.current_loop().is_some() {
                     s.ia
@@ -643,11 +637,24 @@ fn run<const EXTRAS: bool, const RK4: bool>(
                 } else {
                     ic_eff
                 };
-            out.force.push(match phys.lag_w() {
+            let i = if phys.current_loop().is_some() {
+                s.ia
+            } else {
+                ic
+            };
+            let force = match phys.lag_w() {
                 Some(_) => s.fl,
                 None => fm,
-            });
-            k += 1;
+            };
+            while k < n_out && t[k] <= time + tol {
+                out.x.push(s.x);
+                out.v.push(s.v);
+                out.z.push(s.z);
+                out.i.push(i);
+                out.friction.push(f);
+                out.force.push(force);
+                k += 1;
+            }
         }
         if k == n_out {
             break;
