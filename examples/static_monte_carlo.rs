@@ -76,6 +76,7 @@ fn main() {
     ];
     let mut worst: Vec<Vec<f64>> = vec![Vec::new(); schemes.len() + 1];
     let mut outlier_recall = vec![0usize; schemes.len()];
+    let mut fit_time = vec![0.0f64; schemes.len()];
     let mut false_reject = vec![0usize; schemes.len()];
     let mut n_outliers = 0usize;
     let mut rng = Rng(seed);
@@ -113,7 +114,10 @@ fn main() {
             .unwrap_or(f64::INFINITY);
         worst[schemes.len()].push(oracle);
         for (k, (name, opts)) in schemes.iter().enumerate() {
-            let fit = match fit_static(&v, &f, opts) {
+            let tf = std::time::Instant::now();
+            let fit = fit_static(&v, &f, opts);
+            fit_time[k] += tf.elapsed().as_secs_f64();
+            let fit = match fit {
                 Ok(fit) => fit,
                 Err(e) => {
                     eprintln!("{name}: {e}");
@@ -141,15 +145,16 @@ fn main() {
         n_outliers,
         t0.elapsed().as_secs_f64()
     );
-    println!("weighting  median worst rel. err  p95 worst rel. err  outliers rejected  clean points rejected");
+    println!("weighting   median worst rel. err  p95 worst rel. err  outliers rejected  clean points rejected  ms per fit");
     for (k, (name, _)) in schemes.iter().enumerate() {
         println!(
-            "{:<10}  {:>19.3} %  {:>16.3} %  {:>17}  {:>21}",
+            "{:<10}  {:>19.3} %  {:>16.3} %  {:>17}  {:>21}  {:>10.2}",
             name,
             100.0 * quantile(&worst[k], 0.5),
             100.0 * quantile(&worst[k], 0.95),
             outlier_recall[k],
-            false_reject[k]
+            false_reject[k],
+            1e3 * fit_time[k] / n_sets as f64
         );
     }
 }

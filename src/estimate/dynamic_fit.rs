@@ -207,7 +207,7 @@ fn local_metric(
     let mut last_jac = None;
     for _ in 0..10 {
         let s = robust_scale(&e);
-        if !(s > 0.0) {
+        if s.is_nan() || s <= 0.0 {
             break;
         }
         let w = huber.weights(&e, s);
@@ -231,9 +231,10 @@ fn local_metric(
         // e(th + d) ~ e - J d: d = M^-1 J^T W e
         let d = [(m11 * g0 - m01 * g1) / det, (m00 * g1 - m01 * g0) / det];
         let f = wss(&e, &w);
-        let predicted = d[0] * g0 + d[1] * g1; // predicted decrease
-                                               // done when the step would gain less than about one standard error squared
-        if !(predicted > f / e.len() as f64) {
+        // predicted decrease; done when the step would gain less than about one
+        // standard error squared (or the prediction is not a number)
+        let predicted = d[0] * g0 + d[1] * g1;
+        if predicted.is_nan() || predicted <= f / e.len() as f64 {
             break;
         }
         let mut lambda = 1.0;

@@ -83,9 +83,12 @@ struct Tracker {
     best_f: f64,
 }
 
+/// The objective as [`minimize`] takes it.
+type Closure<'a, 'f> = &'a mut (dyn FnMut(&[f64]) -> f64 + 'f);
+
 /// The closure as an argmin problem: `cost` takes `&self`, hence the `RefCell`s.
 struct Objective<'a, 'f> {
-    f: RefCell<&'a mut (dyn FnMut(&[f64]) -> f64 + 'f)>,
+    f: RefCell<Closure<'a, 'f>>,
     track: &'a RefCell<Tracker>,
     /// Divisor of the objective in this run.
     norm: f64,

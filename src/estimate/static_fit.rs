@@ -222,7 +222,7 @@ fn lts_linear(
                 break;
             };
             let on = trimmed(&xn);
-            if !(on < obj * (1.0 - 1e-12)) {
+            if on.is_nan() || on >= obj * (1.0 - 1e-12) {
                 if on <= obj {
                     x = xn;
                     obj = on;
@@ -325,7 +325,7 @@ fn start_values_lts(a: &[f64], y: &[f64]) -> [f64; 4] {
     let amax = a.iter().copied().fold(0.0, f64::max);
     let fscale = median(&y.iter().map(|v| v.abs()).collect::<Vec<_>>()).max(1e-12);
     let n = a.len();
-    let h = ((3 * n + 3) / 4).min(n);
+    let h = (3 * n).div_ceil(4).min(n);
     let seeds = elemental_seeds(n, 30);
     let mut best: Option<(f64, [f64; 4])> = None;
     let ngrid = 41;
