@@ -358,11 +358,23 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
         }
     }
 
+    /// `at_state`: `(g, F)` at this state and time when already known (from a sample).
     #[inline(always)]
-    fn step_exact(&self, s: &mut State, ic: f64, ms: &MotorStep, time: f64) {
+    fn step_exact(
+        &self,
+        s: &mut State,
+        ic: f64,
+        ms: &MotorStep,
+        time: f64,
+        at_state: Option<(f64, f64)>,
+    ) {
         let h = ms.h;
         let fm = self.motor(s, ic, ms);
-        let (a, g, _) = self.accel(fm, s.x, s.v, s.z, time);
+        let (g, f) = at_state.unwrap_or_else(|| {
+            let (g, f, _) = self.fr.eval(s.z, s.v, self.scale(s.x, time));
+            (g, f)
+        });
+        let a = (fm - f - self.effect_force(s.x)) / self.mass;
         s.z = self.fr.advance_z(s.z, s.v, g, h);
         s.v += a * h;
         s.x += s.v * h;
@@ -623,12 +635,15 @@ fn run<const EXTRAS: bool, const RK4: bool>(
                 }
             }
         }
+        let mut at_state = None;
         if k < n_out && t[k] <= time + tol {
             // Record the samples due now. The friction is evaluated here, under this
             // test: inside the loop below, the compiler would hoist the evaluation (an
             // exp()) out of it and run it at every event, sample or not.
             let sc = phys.scale(s.x, time);
-            let (_, f, _) = phys.fr.eval(s.z, s.v, sc);
+            let (g, f, _) = phys.fr.eval(s.z, s.v, sc);
+            // the next plant step starts from this state: it reuses (g, F)
+            at_state = Some((g, f));
             let fm = phys.kf
                 * if phys.current_loop().is_some() {
                     s.ia
@@ -689,7 +704,7 @@ fn run<const EXTRAS: bool, const RK4: bool>(
             if RK4 {
                 phys.step_rk4(&mut s, ic_eff, &ms, tj);
             } else {
-                phys.step_exact(&mut s, ic_eff, &ms, tj);
+                phys.step_exact(&mut s, ic_eff, &ms, tj, at_state.take());
             }
         }
         if !(s.x.is_finite() && s.v.is_finite() && s.z.is_finite()) {
