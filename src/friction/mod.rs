@@ -254,7 +254,9 @@ impl<T: Float> LugreParams<T> {
         if v == T::zero() {
             return z;
         }
-        let zss = v.signum() * g / self.sigma0;
+        // sign(v) as a branch-free select (v != 0 here), cheaper than signum()
+        let sign = if v > T::zero() { T::one() } else { -T::one() };
+        let zss = sign * g / self.sigma0;
         zss + (z - zss) * (-(self.sigma0 * v.abs() * h / g)).exp()
     }
 }

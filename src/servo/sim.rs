@@ -96,7 +96,8 @@ impl<'a> Interp<'a> {
         if tq >= self.t[n - 1] {
             return self.y[n - 1];
         }
-        while self.j + 1 < n && self.t[self.j + 1] <= tq {
+        // tq inside (t[0], t[n-1]): the cursor stops before the last sample
+        while self.t[self.j + 1] <= tq {
             self.j += 1;
         }
         let (t0, t1) = (self.t[self.j], self.t[self.j + 1]);
@@ -674,7 +675,8 @@ fn run<const EXTRAS: bool, const RK4: bool>(
         if k == n_out {
             break;
         }
-        let next = tc.min(t[k]);
+        // min(tc, t[k]) of two finite times (f64::min would also handle NaN)
+        let next = if t[k] < tc { t[k] } else { tc };
         // max(1, ceil(span/h_max - 1e-6)) plant steps; one in the usual case, without
         // the call to ceil() (a libm call on baseline x86-64)
         let r = (next - time) / h_max - 1e-6;
