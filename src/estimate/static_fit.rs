@@ -129,11 +129,27 @@ fn to_params(th: &[f64]) -> [f64; 4] {
 
 /// Weighted linear least squares of `y = fc*(1 - phi) + fs*phi + s2*a` for fixed `vs`.
 fn linear_fit(a: &[f64], y: &[f64], w: &[f64], vs: f64) -> Option<Vector3<f64>> {
+    linear_fit_rows(&design(a, vs), y, w)
+}
+
+/// Rows `(1 - phi, phi, a)` of the linear problem for fixed `vs`.
+fn design(a: &[f64], vs: f64) -> Vec<Vector3<f64>> {
+    a.iter()
+        .map(|&ai| {
+            let phi = (-(ai / vs).powi(2)).exp();
+            Vector3::new(1.0 - phi, phi, ai)
+        })
+        .collect()
+}
+
+/// Weighted linear least squares on precomputed rows.
+fn linear_fit_rows(rows: &[Vector3<f64>], y: &[f64], w: &[f64]) -> Option<Vector3<f64>> {
     let mut ata = Matrix3::zeros();
     let mut aty = Vector3::zeros();
-    for ((&ai, &yi), &wi) in a.iter().zip(y).zip(w) {
-        let phi = (-(ai / vs).powi(2)).exp();
-        let row = Vector3::new(1.0 - phi, phi, ai);
+    for ((row, &yi), &wi) in rows.iter().zip(y).zip(w) {
+        if wi == 0.0 {
+            continue;
+        }
         ata += wi * row * row.transpose();
         aty += wi * yi * row;
     }
@@ -162,13 +178,14 @@ fn lts_linear(
     seeds: &[[usize; 3]],
 ) -> Option<(Vector3<f64>, f64)> {
     let n = a.len();
+    let rows = design(a, vs);
     let mut w = vec![0.0; n];
     let mut r2 = vec![0.0; n];
     let mut order: Vec<usize> = (0..n).collect();
     // one concentration step: keep the h points nearest to the curve of x, refit
     let mut cstep = |x: &Vector3<f64>, w: &mut Vec<f64>| -> Option<(Vector3<f64>, f64)> {
         for i in 0..n {
-            let e = y[i] - curve(&[x[0], x[1], x[2], vs], a[i]);
+            let e = y[i] - rows[i].dot(x);
             r2[i] = e * e;
         }
         order.sort_unstable_by(|&p, &q| r2[p].total_cmp(&r2[q]));
@@ -177,12 +194,10 @@ fn lts_linear(
         for &i in &order[..h] {
             w[i] = 1.0;
         }
-        Some((linear_fit(a, y, w, vs)?, before))
+        Some((linear_fit_rows(&rows, y, w)?, before))
     };
     let trimmed = |x: &Vector3<f64>| -> f64 {
-        let mut e: Vec<f64> = (0..n)
-            .map(|i| (y[i] - curve(&[x[0], x[1], x[2], vs], a[i])).powi(2))
-            .collect();
+        let mut e: Vec<f64> = (0..n).map(|i| (y[i] - rows[i].dot(x)).powi(2)).collect();
         e.sort_unstable_by(|p, q| p.total_cmp(q));
         e[..h].iter().sum()
     };
@@ -190,13 +205,13 @@ fn lts_linear(
     // the plain least-squares fit and elemental fits through three points, two
     // concentration steps each
     let mut starts = Vec::with_capacity(seeds.len() + 1);
-    starts.push(linear_fit(a, y, &vec![1.0; n], vs));
+    starts.push(linear_fit_rows(&rows, y, &vec![1.0; n]));
     for sd in seeds {
         w.iter_mut().for_each(|v| *v = 0.0);
         for &i in sd {
             w[i] = 1.0;
         }
-        starts.push(linear_fit(a, y, &w, vs));
+        starts.push(linear_fit_rows(&rows, y, &w));
     }
     for x0 in starts.into_iter().flatten() {
         let mut x = x0;
