@@ -1,13 +1,18 @@
 """Type stubs of the compiled core (``lugre._core``); use the ``lugre`` package instead."""
 
+from typing import Any
+
 import numpy as np
 import numpy.typing as npt
 
 __all__ = [
     "__version__",
     "check_model",
+    "fit_dynamic_record",
+    "fit_static_points",
     "friction_force",
     "num_threads",
+    "plateaus",
     "simulate",
     "simulate_batch",
     "stribeck",
@@ -47,3 +52,37 @@ def simulate_batch(
     v0: float = 0.0,
 ) -> list[dict[str, npt.NDArray[np.float64]]]: ...
 def num_threads() -> int: ...
+def fit_static_points(
+    v: npt.NDArray[np.float64],
+    f: npt.NDArray[np.float64],
+    weighting: str = "igg",
+    max_iter: int = 20,
+    scale_floor: float = 0.0,
+) -> dict[str, Any]: ...
+def plateaus(
+    t: npt.NDArray[np.float64],
+    x: npt.NDArray[np.float64],
+    force: npt.NDArray[np.float64],
+    v_ref: npt.NDArray[np.float64] | None = None,
+    settle_fraction: float = 0.3,
+    velocity_tolerance: float = 0.02,
+    window: int = 0,
+    min_samples: int = 20,
+    chunks: int = 1,
+) -> dict[str, Any]: ...
+def fit_dynamic_record(
+    model_json: str,
+    t: npt.NDArray[np.float64],
+    x_ref: npt.NDArray[np.float64],
+    x: npt.NDArray[np.float64],
+    weighting: str = "igg",
+    c1: float = 1.0,
+    c2: float = 0.0,
+    sigma0_start: float | None = None,
+    sigma1_start: float | None = None,
+    grid: bool = True,
+    max_iter: int = 20,
+    scale_floor: float = 0.0,
+    substeps: int = 1,
+    integrator: str = "exact",
+) -> dict[str, Any]: ...
