@@ -189,3 +189,41 @@ fn paper_axis_plateaus() {
         assert!(e.abs() < 0.02, "{ep:?} {en:?}");
     }
 }
+
+#[test]
+fn gross_errors_at_the_ends_of_the_speed_range() {
+    // The fastest point has high leverage on sigma2 and fc, the slowest on fs: a
+    // monotone (Huber) start follows a gross error there; the least-trimmed-squares
+    // start does not.
+    let pos = lugre::StaticSet::new(28.7, 60.2, 332.5, 0.01).unwrap();
+    let neg = lugre::StaticSet::new(28.5, 60.1, 333.0, 0.01).unwrap();
+    let mut v = Vec::new();
+    let mut f = Vec::new();
+    let mut k = 0u32;
+    for (sign, set) in [(1.0, &pos), (-1.0, &neg)] {
+        for i in 0..24 {
+            let s = sign * 2e-4 * (0.4f64 / 2e-4).powf(i as f64 / 23.0);
+            // small deterministic "noise", +-0.2 N
+            k = k.wrapping_mul(1103515245).wrapping_add(12345);
+            let noise = 0.4 * ((k >> 16) as f64 / 65536.0 - 0.5);
+            v.push(s);
+            f.push(set.stribeck(s) + noise);
+        }
+    }
+    f[23] *= 1.2; // fastest, v > 0
+    f[24] *= 0.8; // slowest, v < 0
+    f[47] *= 0.85; // fastest, v < 0
+    let fit = fit_static(&v, &f, &StaticFitOptions::default()).unwrap();
+    eprintln!(
+        "{:?}\n{:?}\nrejected {:?}",
+        fit.positive.set, fit.negative.set, fit.rejected
+    );
+    for r in [23, 24, 47] {
+        assert!(fit.rejected.contains(&r), "{:?}", fit.rejected);
+    }
+    let ep = rel_errors(&fit.positive.set, &[28.7, 60.2, 332.5, 0.01]);
+    let en = rel_errors(&fit.negative.set, &[28.5, 60.1, 333.0, 0.01]);
+    for e in ep.iter().chain(&en) {
+        assert!(e.abs() < 0.02, "{ep:?} {en:?}");
+    }
+}
