@@ -13,7 +13,8 @@
  *   arrays handed to lugre.simulate; t[0] = 0, t[m-1] = steps/rate).
  * Prints one line: "seconds=<s> steps=<n> x=<x> v=<v> z=<z>".
  *
- * Built by benches/compare.py with gcc -O3 -march=native.
+ * Built by benches/compare.py with gcc -O3 (baseline x86-64, like the Rust build: no FMA
+ * contraction, so the same arithmetic as lugre) and with -march=native for comparison.
  */
 #include <math.h>
 #include <stdint.h>

@@ -24,13 +24,13 @@ const PAPER: &str = r#"{"axis": {"mass": 25, "force_constant": 25},
 const RATE: f64 = 1e4;
 
 /// Sample grid of `m` points over `steps` control periods and a sine reference
-/// (5 cm, 0.7 Hz: stick at each reversal, slip in between).
+/// (5 mm, 25 periods over the run: stick at each reversal, slip in between).
 fn grid(steps: usize, m: usize) -> (Vec<f64>, Vec<f64>) {
     let end = steps as f64 / RATE;
     let t: Vec<f64> = (0..m).map(|k| end * k as f64 / (m - 1) as f64).collect();
     let xr = t
         .iter()
-        .map(|&s| 0.05 * (2.0 * std::f64::consts::PI * 0.7 * s).sin())
+        .map(|&s| 5e-3 * (2.0 * std::f64::consts::PI * 25.0 * s / end).sin())
         .collect();
     (t, xr)
 }

@@ -35,7 +35,7 @@ RATE = 1e4  # control rate of Model.paper()
 
 def _grid(steps: int, m: int = 1001) -> tuple[np.ndarray, np.ndarray]:
     t = np.linspace(0.0, steps / RATE, m)
-    return t, 5e-3 * np.sin(2 * np.pi * 2.0 * t)
+    return t, 5e-3 * np.sin(2 * np.pi * 25.0 * t / t[-1])  # 25 periods over the run
 
 
 def _steps_per_second() -> float:
@@ -174,7 +174,7 @@ MEMORY_SCRIPT = textwrap.dedent(
 
     steps = int(float(sys.argv[1]))
     t = np.linspace(0.0, steps / 1e4, 1001)
-    xr = 5e-3 * np.sin(2 * np.pi * 2.0 * t)
+    xr = 5e-3 * np.sin(2 * np.pi * 25.0 * t / t[-1])
     m = lugre.Model.paper()
     lugre.simulate(m, t[:11] / 1e5, xr[:11])  # load everything once
     before = peak_mb()
