@@ -210,7 +210,8 @@ fn gross_errors_at_the_ends_of_the_speed_range() {
             f.push(set.stribeck(s) + noise);
         }
     }
-    f[23] *= 1.2; // fastest, v > 0
+    f[22] *= 1.15; // the two fastest, v > 0
+    f[23] *= 1.2;
     f[24] *= 0.8; // slowest, v < 0
     f[47] *= 0.85; // fastest, v < 0
     let fit = fit_static(&v, &f, &StaticFitOptions::default()).unwrap();
@@ -218,7 +219,7 @@ fn gross_errors_at_the_ends_of_the_speed_range() {
         "{:?}\n{:?}\nrejected {:?}",
         fit.positive.set, fit.negative.set, fit.rejected
     );
-    for r in [23, 24, 47] {
+    for r in [22, 23, 24, 47] {
         assert!(fit.rejected.contains(&r), "{:?}", fit.rejected);
     }
     let ep = rel_errors(&fit.positive.set, &[28.7, 60.2, 332.5, 0.01]);
