@@ -54,6 +54,7 @@ fn static_points(n: usize) -> (Vec<f64>, Vec<f64>) {
 
 fn static_fit(c: &mut Criterion) {
     let mut g = c.benchmark_group("fit_static");
+    g.sample_size(10);
     for &n in &[20usize, 100, 1000] {
         let (v, f) = static_points(n);
         let opts = StaticFitOptions::default();
