@@ -18,12 +18,11 @@
 //! kept points are then refitted by plain least squares, with the rejections
 //! re-checked, which recovers the efficiency the down-weighting band costs.
 
-use super::irls::{irls, IrlsOutcome, IrlsSetup};
 use super::nelder_mead::{minimize, NmOptions};
 use super::robust::{median, robust_scale, t_quantile_975, Weighting};
 use crate::error::{check_finite, check_len, Error, Result};
 use crate::friction::StaticSet;
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{Matrix4, Vector4};
 
 /// Fewest nonzero-speed points per direction that [`fit_static`] accepts (4 parameters
 /// plus one degree of freedom for the residual scale).
@@ -122,136 +121,411 @@ fn curve(p: &[f64; 4], a: f64) -> f64 {
     p[0] + (p[1] - p[0]) * (-(r * r)).exp() + p[2] * a
 }
 
-fn to_params(th: &[f64]) -> [f64; 4] {
-    let fc = th[0].exp();
-    [fc, fc + th[1].exp(), th[2].exp(), th[3].exp()]
+/// The Stribeck shape `phi_i = exp(-(a_i/vs)^2)` of every point.
+#[inline]
+fn fill_phi(a: &[f64], vs: f64, phi: &mut [f64]) {
+    let iv = 1.0 / vs;
+    for (p, &ai) in phi.iter_mut().zip(a) {
+        let r = ai * iv;
+        *p = (-(r * r)).exp();
+    }
 }
 
-/// Weighted linear least squares of `y = fc*(1 - phi) + fs*phi + s2*a` for fixed `vs`.
-fn linear_fit(a: &[f64], y: &[f64], w: &[f64], vs: f64) -> Option<Vector3<f64>> {
-    linear_fit_rows(&design(a, vs), y, w)
+/// Weighted normal equations of the linear part for fixed `vs`: columns
+/// `(1, phi, a)`, unknowns `(fc - fc_min, fs - fc, sigma2)`.
+#[derive(Clone, Copy, Default)]
+struct Normal {
+    m: [[f64; 3]; 3],
+    b: [f64; 3],
 }
 
-/// Rows `(1 - phi, phi, a)` of the linear problem for fixed `vs`.
-fn design(a: &[f64], vs: f64) -> Vec<Vector3<f64>> {
-    a.iter()
-        .map(|&ai| {
-            let phi = (-(ai / vs).powi(2)).exp();
-            Vector3::new(1.0 - phi, phi, ai)
-        })
+impl Normal {
+    #[inline]
+    fn add(&mut self, phi: f64, a: f64, y: f64, w: f64) {
+        let (wp, wa) = (w * phi, w * a);
+        self.m[0][0] += w;
+        self.m[0][1] += wp;
+        self.m[0][2] += wa;
+        self.m[1][1] += wp * phi;
+        self.m[1][2] += wp * a;
+        self.m[2][2] += wa * a;
+        self.b[0] += w * y;
+        self.b[1] += wp * y;
+        self.b[2] += wa * y;
+    }
+
+    /// Solve on the free unknowns (`free` bit k set) with the others held at zero, by
+    /// Cholesky of the column-scaled system; `None` when (nearly) singular.
+    fn solve_free(&self, free: u8) -> Option<[f64; 3]> {
+        let mut idx = [0usize; 3];
+        let mut k = 0;
+        for (j, slot) in (0..3).filter(|j| free & (1 << j) != 0).zip(0..) {
+            idx[slot] = j;
+            k = slot + 1;
+        }
+        let mut x = [0.0; 3];
+        if k == 0 {
+            return Some(x);
+        }
+        let mut d = [0.0; 3];
+        for r in 0..k {
+            let mrr = self.m[idx[r]][idx[r]];
+            if !(mrr > 0.0 && mrr.is_finite()) {
+                return None;
+            }
+            d[r] = 1.0 / mrr.sqrt();
+        }
+        let at = |r: usize, c: usize| {
+            let (i, j) = (idx[r].min(idx[c]), idx[r].max(idx[c]));
+            self.m[i][j] * d[r] * d[c]
+        };
+        // Cholesky L L^T of the scaled matrix (unit diagonal before factoring)
+        let mut l = [[0.0; 3]; 3];
+        for r in 0..k {
+            for c in 0..=r {
+                let mut s = at(r, c);
+                for q in 0..c {
+                    s -= l[r][q] * l[c][q];
+                }
+                if r == c {
+                    if s <= 1e-13 {
+                        return None;
+                    }
+                    l[r][r] = s.sqrt();
+                } else {
+                    l[r][c] = s / l[c][c];
+                }
+            }
+        }
+        let mut z = [0.0; 3];
+        for r in 0..k {
+            let mut s = self.b[idx[r]] * d[r];
+            for q in 0..r {
+                s -= l[r][q] * z[q];
+            }
+            z[r] = s / l[r][r];
+        }
+        for r in (0..k).rev() {
+            let mut s = z[r];
+            for q in r + 1..k {
+                s -= l[q][r] * x[idx[q]] / d[q];
+            }
+            x[idx[r]] = s / l[r][r] * d[r];
+        }
+        x.iter().all(|v| v.is_finite()).then_some(x)
+    }
+
+    /// `x^T M x - 2 x^T b` (the weighted sum of squares up to a constant).
+    fn quad(&self, x: &[f64; 3]) -> f64 {
+        let m = &self.m;
+        let mx = [
+            m[0][0] * x[0] + m[0][1] * x[1] + m[0][2] * x[2],
+            m[0][1] * x[0] + m[1][1] * x[1] + m[1][2] * x[2],
+            m[0][2] * x[0] + m[1][2] * x[1] + m[2][2] * x[2],
+        ];
+        (0..3).map(|k| x[k] * (mx[k] - 2.0 * self.b[k])).sum()
+    }
+
+    /// Least squares with every unknown nonnegative (`fc >= fc_min`, `fs >= fc`,
+    /// `sigma2 >= 0`): the unconstrained solution when it is feasible, else the best
+    /// feasible solution over the faces (an exhaustive active set; three unknowns).
+    fn solve_nonneg(&self) -> [f64; 3] {
+        if let Some(x) = self.solve_free(0b111) {
+            if x.iter().all(|v| *v >= 0.0) {
+                return x;
+            }
+        }
+        let mut best = ([0.0; 3], 0.0);
+        for free in [0b011u8, 0b101, 0b110, 0b001, 0b010, 0b100] {
+            if let Some(x) = self.solve_free(free) {
+                if x.iter().all(|v| *v >= 0.0) {
+                    let q = self.quad(&x);
+                    if q < best.1 {
+                        best = (x, q);
+                    }
+                }
+            }
+        }
+        best.0
+    }
+}
+
+/// One direction's points and work buffers of the separable (variable projection)
+/// problem: for fixed `vs` the curve is linear in `(fc, fs - fc, sigma2)`, solved in
+/// closed form, so the nonlinear search is over `ln vs` alone (Golub and Pereyra 1973).
+struct Sep<'a> {
+    a: &'a [f64],
+    y: &'a [f64],
+    /// Smallest `fc` (a tiny positive force: the model needs `fc > 0`).
+    fc_min: f64,
+    /// Search interval of `ln vs` (the profile is flat far outside the speed range).
+    ln_lo: f64,
+    ln_hi: f64,
+    phi: Vec<f64>,
+}
+
+impl<'a> Sep<'a> {
+    fn new(a: &'a [f64], y: &'a [f64], fscale: f64) -> Self {
+        let amin = a.iter().copied().fold(f64::INFINITY, f64::min);
+        let amax = a.iter().copied().fold(0.0, f64::max);
+        Self {
+            a,
+            y,
+            fc_min: 1e-9 * fscale,
+            ln_lo: amin.ln() - 7.0,
+            ln_hi: amax.ln() + 7.0,
+            phi: vec![0.0; a.len()],
+        }
+    }
+
+    /// Normal equations at the `phi` in the buffer.
+    fn normal(&self, w: &[f64]) -> Normal {
+        let mut ne = Normal::default();
+        for i in 0..self.a.len() {
+            if w[i] != 0.0 {
+                ne.add(self.phi[i], self.a[i], self.y[i] - self.fc_min, w[i]);
+            }
+        }
+        ne
+    }
+
+    fn params(&self, x: &[f64; 3], vs: f64) -> [f64; 4] {
+        let fc = self.fc_min + x[0];
+        [fc, fc + x[1], x[2], vs]
+    }
+
+    /// The variable-projection objective: the weighted sum of squares at the best
+    /// linear parameters for `vs = exp(ln_vs)`, and the four parameters.
+    fn profile(&mut self, w: &[f64], ln_vs: f64) -> (f64, [f64; 4]) {
+        let vs = ln_vs.exp();
+        if !(ln_vs >= self.ln_lo && ln_vs <= self.ln_hi) {
+            return (f64::INFINITY, [f64::NAN; 4]);
+        }
+        fill_phi(self.a, vs, &mut self.phi);
+        let x = self.normal(w).solve_nonneg();
+        let p = self.params(&x, vs);
+        let d = p[1] - p[0];
+        let mut ss = 0.0;
+        for i in 0..self.a.len() {
+            let e = self.y[i] - (p[0] + d * self.phi[i] + p[2] * self.a[i]);
+            ss += w[i] * e * e;
+        }
+        (ss, p)
+    }
+
+    fn residuals(&self, p: &[f64; 4]) -> Vec<f64> {
+        self.a
+            .iter()
+            .zip(self.y)
+            .map(|(&ai, &yi)| yi - curve(p, ai))
+            .collect()
+    }
+}
+
+/// Minimum of the weighted profile over `ln vs` by Nelder-Mead from `ln_vs0`.
+/// Returns the parameters and the evaluations used.
+fn vp_minimize(
+    sep: &mut Sep,
+    w: &[f64],
+    ln_vs0: f64,
+    step: f64,
+    nm: &NmOptions,
+    floor: f64,
+) -> ([f64; 4], usize) {
+    // `floor` (a constant) makes the relative stopping rule of the simplex absolute
+    // near a zero sum of squares (noise-free data)
+    let mut f = |x: &[f64]| sep.profile(w, x[0]).0 + floor;
+    let r = minimize(&mut f, &[ln_vs0], &[step], nm);
+    let (_, p) = sep.profile(w, r.x[0]);
+    (p, r.evals + 1)
+}
+
+/// Outcome of one IRLS path.
+struct Outcome {
+    p: [f64; 4],
+    residuals: Vec<f64>,
+    weights: Vec<f64>,
+    scale: f64,
+    iterations: usize,
+    converged: bool,
+    evals: usize,
+}
+
+/// Settings shared by the IRLS runs of one direction.
+struct Cfg {
+    max_outer: usize,
+    tol: f64,
+    scale_floor: f64,
+    nm: NmOptions,
+    /// Added to the profile objective (see [`vp_minimize`]).
+    obj_floor: f64,
+}
+
+/// Largest relative change between two parameter vectors.
+fn max_rel_change(p: &[f64; 4], q: &[f64; 4]) -> f64 {
+    p.iter()
+        .zip(q)
+        .map(|(a, b)| (a - b).abs() / a.abs().max(b.abs()).max(1e-300))
+        .fold(0.0, f64::max)
+}
+
+/// IRLS (eqs. 19-24): weights from the residuals at the current parameters and their
+/// robust scale, then the weighted profile minimised over `ln vs`, until the weights
+/// or the parameters settle.
+fn irls_vp(sep: &mut Sep, p0: [f64; 4], weighting: Weighting, cfg: &Cfg) -> Outcome {
+    let mut p = p0;
+    let mut e = sep.residuals(&p);
+    let scale_of = |e: &[f64]| robust_scale(e).max(cfg.scale_floor);
+    let mut s = scale_of(&e);
+    let mut w = weighting.weights(&e, s);
+    let mut evals = 1;
+    let mut converged = false;
+    let mut iterations = 0;
+    let mut step = 0.3;
+    while iterations < cfg.max_outer.max(1) {
+        iterations += 1;
+        let (pn, ev) = vp_minimize(sep, &w, p[3].ln(), step, &cfg.nm, cfg.obj_floor);
+        evals += ev;
+        let dtheta = max_rel_change(&p, &pn);
+        p = pn;
+        e = sep.residuals(&p);
+        s = scale_of(&e);
+        let w_new = weighting.weights(&e, s);
+        let (dw, dw_sum) = w_new
+            .iter()
+            .zip(&w)
+            .map(|(a, b)| (a - b).abs())
+            .fold((0.0f64, 0.0), |(m, t), d| (m.max(d), t + d));
+        let dw_mean = dw_sum / w.len().max(1) as f64;
+        w = w_new;
+        if dw <= 1e-3 || dw_mean <= 1e-5 || dtheta <= cfg.tol {
+            converged = true;
+            break;
+        }
+        // later rounds start close to the answer
+        step = 0.03;
+    }
+    Outcome {
+        p,
+        residuals: e,
+        weights: w,
+        scale: s,
+        iterations,
+        converged,
+        evals,
+    }
+}
+
+/// Least squares on the points IRLS kept, re-checking the rejections (`|e| > k1*s`,
+/// `s` the scale of the kept residuals at the refit) until the kept set settles.
+fn refit_kept(sep: &mut Sep, out: &mut Outcome, k1: f64, cfg: &Cfg) {
+    let mut keep: Vec<f64> = out
+        .weights
+        .iter()
+        .map(|w| if *w > 0.0 { 1.0 } else { 0.0 })
+        .collect();
+    // a Gaussian truncated at +-k1 has this fraction of the unit variance
+    let phi = (-0.5 * k1 * k1).exp() / (2.0 * std::f64::consts::PI).sqrt();
+    let var_factor = 1.0 - 2.0 * k1 * phi / libm::erf(k1 / std::f64::consts::SQRT_2);
+    for _ in 0..5 {
+        let n_kept = keep.iter().sum::<f64>();
+        if n_kept < MIN_POINTS_PER_DIRECTION as f64 {
+            return;
+        }
+        let (p, ev) = vp_minimize(sep, &keep, out.p[3].ln(), 0.03, &cfg.nm, cfg.obj_floor);
+        out.evals += ev;
+        let e = sep.residuals(&p);
+        // scale of the kept points (n_kept - 4 degrees of freedom), made consistent for
+        // a Gaussian truncated at +-k1: more efficient than the MAD of all residuals,
+        // whose noise in a small sample moves the rejection threshold
+        let ss: f64 = e.iter().zip(&keep).map(|(ei, wi)| wi * ei * ei).sum();
+        let s = (ss / (n_kept - 4.0) / var_factor)
+            .sqrt()
+            .max(cfg.scale_floor);
+        let new_keep: Vec<f64> = e
+            .iter()
+            .map(|ei| if ei.abs() <= k1 * s { 1.0 } else { 0.0 })
+            .collect();
+        out.p = p;
+        out.residuals = e;
+        out.scale = s;
+        out.weights = keep.clone();
+        if new_keep == keep {
+            return;
+        }
+        keep = new_keep;
+    }
+}
+
+/// Median of a scratch buffer (reordered; NaN-free input).
+fn median_mut(b: &mut [f64]) -> f64 {
+    let n = b.len();
+    let (lo, m, _) = b.select_nth_unstable_by(n / 2, |x, y| x.total_cmp(y));
+    let m = *m;
+    if n % 2 == 1 {
+        m
+    } else {
+        0.5 * (m + lo.iter().copied().fold(f64::NEG_INFINITY, f64::max))
+    }
+}
+
+/// Nodes of the start grid over `ln vs`: from half the slowest to twice the fastest
+/// speed.
+fn grid_nodes(a: &[f64], count: usize) -> Vec<f64> {
+    let amin = a.iter().copied().fold(f64::INFINITY, f64::min);
+    let amax = a.iter().copied().fold(0.0, f64::max);
+    let (lo, hi) = ((amin * 0.5).ln(), (amax * 2.0).ln());
+    (0..count)
+        .map(|k| (lo + (hi - lo) * k as f64 / (count - 1) as f64).exp())
         .collect()
 }
 
-/// Weighted linear least squares on precomputed rows.
-fn linear_fit_rows(rows: &[Vector3<f64>], y: &[f64], w: &[f64]) -> Option<Vector3<f64>> {
-    let mut ata = Matrix3::zeros();
-    let mut aty = Vector3::zeros();
-    for ((row, &yi), &wi) in rows.iter().zip(y).zip(w) {
-        if wi == 0.0 {
-            continue;
-        }
-        ata += wi * row * row.transpose();
-        aty += wi * yi * row;
-    }
-    // scale the columns to make the solve well conditioned
-    let d = Vector3::new(
-        ata[(0, 0)].sqrt().max(1e-300),
-        ata[(1, 1)].sqrt().max(1e-300),
-        ata[(2, 2)].sqrt().max(1e-300),
-    );
-    let dm = Matrix3::from_diagonal(&d.map(|x| 1.0 / x));
-    let m = dm * ata * dm;
-    let sol = m.try_inverse()? * (dm * aty);
-    let x = dm * sol;
-    x.iter().all(|v| v.is_finite()).then_some(x)
-}
+/// Number of `ln vs` nodes of the start grids.
+const GRID_NODES: usize = 25;
 
-/// Least trimmed squares of `y = fc*(1 - phi) + fs*phi + s2*a` for fixed `vs`: the
-/// three coefficients minimising the sum of the `h` smallest squared residuals,
-/// by concentration steps (Rousseeuw and Van Driessen 2006) from elemental starts.
-/// Returns the coefficients and that trimmed sum.
-fn lts_linear(
-    a: &[f64],
-    y: &[f64],
-    vs: f64,
-    h: usize,
-    seeds: &[[usize; 3]],
-) -> Option<(Vector3<f64>, f64)> {
-    let n = a.len();
-    let rows = design(a, vs);
-    let mut w = vec![0.0; n];
-    let mut r2 = vec![0.0; n];
-    let mut order: Vec<usize> = (0..n).collect();
-    // one concentration step: keep the h points nearest to the curve of x, refit
-    let mut cstep = |x: &Vector3<f64>, w: &mut Vec<f64>| -> Option<(Vector3<f64>, f64)> {
-        for i in 0..n {
-            let e = y[i] - rows[i].dot(x);
-            r2[i] = e * e;
-        }
-        order.sort_unstable_by(|&p, &q| r2[p].total_cmp(&r2[q]));
-        let before: f64 = order[..h].iter().map(|&i| r2[i]).sum();
-        w.iter_mut().for_each(|v| *v = 0.0);
-        for &i in &order[..h] {
-            w[i] = 1.0;
-        }
-        Some((linear_fit_rows(&rows, y, w)?, before))
-    };
-    let trimmed = |x: &Vector3<f64>| -> f64 {
-        let mut e: Vec<f64> = (0..n).map(|i| (y[i] - rows[i].dot(x)).powi(2)).collect();
-        e.sort_unstable_by(|p, q| p.total_cmp(q));
-        e[..h].iter().sum()
-    };
-    let mut cands: Vec<(f64, Vector3<f64>)> = Vec::new();
-    // the plain least-squares fit and elemental fits through three points, two
-    // concentration steps each
-    let mut starts = Vec::with_capacity(seeds.len() + 1);
-    starts.push(linear_fit_rows(&rows, y, &vec![1.0; n]));
-    for sd in seeds {
-        w.iter_mut().for_each(|v| *v = 0.0);
-        for &i in sd {
-            w[i] = 1.0;
-        }
-        starts.push(linear_fit_rows(&rows, y, &w));
-    }
-    for x0 in starts.into_iter().flatten() {
-        let mut x = x0;
-        for _ in 0..2 {
-            match cstep(&x, &mut w) {
-                Some((xn, _)) => x = xn,
-                None => break,
+/// Start values `(fc, fs, sigma2, vs)` from the `ln vs` grid (Huber).
+///
+/// At each node a few Huber IRLS steps of the linear fit, scored by the median
+/// absolute residual.
+fn start_values_huber(sep: &mut Sep) -> Option<[f64; 4]> {
+    let n = sep.a.len();
+    let huber = Weighting::huber();
+    let mut w = vec![1.0; n];
+    let mut e = vec![0.0; n];
+    let mut buf = vec![0.0; n];
+    let mut best: Option<(f64, [f64; 4])> = None;
+    let fscale = sep.fc_min * 1e9;
+    for vs in grid_nodes(sep.a, GRID_NODES) {
+        fill_phi(sep.a, vs, &mut sep.phi);
+        w.iter_mut().for_each(|v| *v = 1.0);
+        let mut score = f64::INFINITY;
+        let mut p = [f64::NAN; 4];
+        for it in 0..5 {
+            p = sep.params(&sep.normal(&w).solve_nonneg(), vs);
+            let d = p[1] - p[0];
+            for i in 0..n {
+                e[i] = sep.y[i] - (p[0] + d * sep.phi[i] + p[2] * sep.a[i]);
             }
-        }
-        let obj = trimmed(&x);
-        if obj.is_finite() {
-            cands.push((obj, x));
-        }
-    }
-    cands.sort_by(|p, q| p.0.total_cmp(&q.0));
-    // the best few to convergence
-    let mut best: Option<(Vector3<f64>, f64)> = None;
-    for (_, x0) in cands.into_iter().take(4) {
-        let mut x = x0;
-        let mut obj = trimmed(&x);
-        for _ in 0..20 {
-            let Some((xn, _)) = cstep(&x, &mut w) else {
-                break;
-            };
-            let on = trimmed(&xn);
-            if on.is_nan() || on >= obj * (1.0 - 1e-12) {
-                if on <= obj {
-                    x = xn;
-                    obj = on;
-                }
+            buf.iter_mut().zip(&e).for_each(|(b, x)| *b = *x);
+            let med = median_mut(&mut buf);
+            buf.iter_mut()
+                .zip(&e)
+                .for_each(|(b, x)| *b = (x - med).abs());
+            let s = (1.4826 * median_mut(&mut buf)).max(1e-12 * fscale);
+            if it == 4 {
+                buf.iter_mut().zip(&e).for_each(|(b, x)| *b = x.abs());
+                score = median_mut(&mut buf);
                 break;
             }
-            x = xn;
-            obj = on;
+            for (wi, ei) in w.iter_mut().zip(&e) {
+                *wi = huber.weight(ei / s);
+            }
         }
-        if best.as_ref().is_none_or(|b| obj < b.1) {
-            best = Some((x, obj));
+        if score.is_finite() && best.is_none_or(|(b, _)| score < b) {
+            best = Some((score, p));
         }
     }
-    best
+    best.map(|b| b.1)
 }
 
 /// Elemental subsets (three distinct indices below `n`) from a fixed-seed generator,
@@ -275,57 +549,63 @@ fn elemental_seeds(n: usize, count: usize) -> Vec<[usize; 3]> {
     out
 }
 
-/// Start values `(fc, fs, sigma2, vs)` from the `ln vs` grid (Huber).
-///
-/// At each node a Huber IRLS linear fit, scored by the median absolute residual.
-fn start_values_huber(a: &[f64], y: &[f64]) -> [f64; 4] {
-    let amin = a.iter().copied().fold(f64::INFINITY, f64::min);
-    let amax = a.iter().copied().fold(0.0, f64::max);
-    let fscale = median(&y.iter().map(|v| v.abs()).collect::<Vec<_>>()).max(1e-12);
-    let huber = Weighting::huber();
-    let mut best: Option<(f64, [f64; 4])> = None;
-    let ngrid = 41;
-    let (lo, hi) = ((amin * 0.5).ln(), (amax * 2.0).ln());
-    for k in 0..ngrid {
-        let vs = (lo + (hi - lo) * k as f64 / (ngrid - 1) as f64).exp();
-        let mut w = vec![1.0; a.len()];
-        let mut x = match linear_fit(a, y, &w, vs) {
-            Some(x) => x,
-            None => continue,
-        };
-        for _ in 0..10 {
-            let e: Vec<f64> = a
-                .iter()
-                .zip(y)
-                .map(|(&ai, &yi)| yi - curve(&[x[0], x[1], x[2], vs], ai))
-                .collect();
-            let s = robust_scale(&e).max(1e-12 * fscale);
-            w = huber.weights(&e, s);
-            match linear_fit(a, y, &w, vs) {
-                Some(xn) => x = xn,
-                None => break,
-            }
+/// Least-trimmed-squares work at one `ln vs` node (the `phi` of the node in `sep`).
+struct Lts {
+    h: usize,
+    r2: Vec<f64>,
+    order: Vec<usize>,
+}
+
+impl Lts {
+    /// Fit on the points `sub`.
+    fn fit(sep: &Sep, sub: &[usize], vs: f64) -> [f64; 4] {
+        let mut ne = Normal::default();
+        for &i in sub {
+            ne.add(sep.phi[i], sep.a[i], sep.y[i] - sep.fc_min, 1.0);
         }
-        let p = [x[0], x[1], x[2], vs];
-        let score = median(
-            &a.iter()
-                .zip(y)
-                .map(|(&ai, &yi)| (yi - curve(&p, ai)).abs())
-                .collect::<Vec<_>>(),
-        );
-        if score.is_finite() && best.is_none_or(|(b, _)| score < b) {
-            best = Some((score, p));
-        }
+        sep.params(&ne.solve_nonneg(), vs)
     }
-    let mut p = best
-        .map(|b| b.1)
-        .unwrap_or([fscale, 1.5 * fscale, 0.0, amax]);
-    // keep inside the parametrisation (all positive, fs > fc)
-    p[0] = p[0].max(1e-3 * fscale);
-    p[1] = p[1].max(p[0] * 1.01 + 1e-6 * fscale);
-    p[2] = p[2].max(1e-6 * fscale / amax.max(1e-300));
-    p[3] = p[3].clamp(amin * 0.5, amax * 2.0);
-    p
+
+    /// One concentration step (Rousseeuw and Van Driessen 2006): the trimmed sum of
+    /// `p` (the `h` smallest squared residuals) and the fit on those `h` points, whose
+    /// trimmed sum is no larger.
+    fn cstep(&mut self, sep: &Sep, p: &[f64; 4]) -> (f64, [f64; 4]) {
+        let d = p[1] - p[0];
+        for i in 0..sep.a.len() {
+            let e = sep.y[i] - (p[0] + d * sep.phi[i] + p[2] * sep.a[i]);
+            self.r2[i] = e * e;
+        }
+        let r2 = &self.r2;
+        let h = self.h;
+        if h < self.order.len() {
+            self.order
+                .select_nth_unstable_by(h, |&i, &j| r2[i].total_cmp(&r2[j]));
+        }
+        let sum = self.order[..h].iter().map(|&i| r2[i]).sum();
+        (sum, Lts::fit(sep, &self.order[..h], p[3]))
+    }
+
+    /// Concentration steps from `p` until the trimmed sum stops decreasing (at most
+    /// `max_steps`); the best trimmed sum, its fit and its subset in `self.order[..h]`.
+    fn concentrate(&mut self, sep: &Sep, p: [f64; 4], max_steps: usize) -> (f64, [f64; 4]) {
+        let (mut obj, mut next) = self.cstep(sep, &p);
+        let mut cur = p;
+        for _ in 1..max_steps {
+            let (o, nx) = self.cstep(sep, &next);
+            if !(o < obj * (1.0 - 1e-12)) {
+                if o <= obj {
+                    return (o, next);
+                }
+                // the last step did not improve: restore the subset of `cur`
+                self.cstep(sep, &cur);
+                return (obj, cur);
+            }
+            cur = next;
+            obj = o;
+            next = nx;
+        }
+        (obj, cur)
+    }
 }
 
 /// Start values `(fc, fs, sigma2, vs)` from the `ln vs` grid (least trimmed squares).
@@ -335,88 +615,73 @@ fn start_values_huber(a: &[f64], y: &[f64]) -> [f64; 4] {
 /// the speed range, where a single point has high leverage on `sigma2` and `fc` and
 /// a monotone M-estimate (Huber) follows it. The node with the smallest trimmed sum
 /// gives the start: the high-breakdown first stage of an MM-estimate (Yohai 1987).
-fn start_values_lts(a: &[f64], y: &[f64]) -> [f64; 4] {
-    let amin = a.iter().copied().fold(f64::INFINITY, f64::min);
-    let amax = a.iter().copied().fold(0.0, f64::max);
-    let fscale = median(&y.iter().map(|v| v.abs()).collect::<Vec<_>>()).max(1e-12);
-    let n = a.len();
+///
+/// The nodes are visited in order of speed; at each, concentration steps start from
+/// the plain fit, from the best subsets of the previous node and of all nodes so far,
+/// and from a few fresh elemental (three-point) subsets, so that a good subset found
+/// at one node is carried to its neighbours and the elemental subsets are spread over
+/// the grid instead of being repeated at every node.
+fn start_values_lts(sep: &mut Sep) -> Option<[f64; 4]> {
+    let n = sep.a.len();
     let h = (3 * n).div_ceil(4).min(n);
-    let seeds = elemental_seeds(n, 30);
-    let mut best: Option<(f64, [f64; 4])> = None;
-    let ngrid = 41;
-    let (lo, hi) = ((amin * 0.5).ln(), (amax * 2.0).ln());
-    for k in 0..ngrid {
-        let vs = (lo + (hi - lo) * k as f64 / (ngrid - 1) as f64).exp();
-        let Some((x, score)) = lts_linear(a, y, vs, h, &seeds) else {
+    const SEEDS_PER_NODE: usize = 3;
+    let nodes = grid_nodes(sep.a, GRID_NODES);
+    let seeds = elemental_seeds(n, SEEDS_PER_NODE * nodes.len());
+    let mut lts = Lts {
+        h,
+        r2: vec![0.0; n],
+        order: (0..n).collect(),
+    };
+    let all: Vec<usize> = (0..n).collect();
+    let mut prev: Option<Vec<usize>> = None;
+    let mut global: Option<(f64, [f64; 4], Vec<usize>)> = None;
+    for (k, &vs) in nodes.iter().enumerate() {
+        fill_phi(sep.a, vs, &mut sep.phi);
+        let mut starts: Vec<[f64; 4]> = Vec::with_capacity(SEEDS_PER_NODE + 3);
+        starts.push(Lts::fit(sep, &all, vs));
+        if let Some(s) = &prev {
+            starts.push(Lts::fit(sep, s, vs));
+        }
+        if let Some((_, _, s)) = &global {
+            if prev.as_ref() != Some(s) {
+                starts.push(Lts::fit(sep, s, vs));
+            }
+        }
+        for sd in &seeds[k * SEEDS_PER_NODE..(k + 1) * SEEDS_PER_NODE] {
+            starts.push(Lts::fit(sep, sd, vs));
+        }
+        let mut node_best: Option<(f64, [f64; 4], Vec<usize>)> = None;
+        for p0 in starts {
+            let (obj, p) = lts.concentrate(sep, p0, 10);
+            if obj.is_finite() && node_best.as_ref().is_none_or(|b| obj < b.0) {
+                let mut sub = lts.order[..h].to_vec();
+                sub.sort_unstable();
+                node_best = Some((obj, p, sub));
+            }
+        }
+        let Some(nb) = node_best else {
             continue;
         };
-        let p = [x[0], x[1], x[2], vs];
-        if score.is_finite() && best.is_none_or(|(b, _)| score < b) {
-            best = Some((score, p));
+        prev = Some(nb.2.clone());
+        if global.as_ref().is_none_or(|g| nb.0 < g.0) {
+            global = Some(nb);
         }
     }
-    let mut p = best
-        .map(|b| b.1)
-        .unwrap_or([fscale, 1.5 * fscale, 0.0, amax]);
-    // keep inside the parametrisation (all positive, fs > fc)
+    global.map(|g| g.1)
+}
+
+/// Keep start values inside the model's domain (all positive, `fs > fc`).
+fn clamp_start(p: Option<[f64; 4]>, a: &[f64], fscale: f64) -> [f64; 4] {
+    let amin = a.iter().copied().fold(f64::INFINITY, f64::min);
+    let amax = a.iter().copied().fold(0.0, f64::max);
+    let mut p =
+        p.filter(|p| p.iter().all(|v| v.is_finite()))
+            .unwrap_or([fscale, 1.5 * fscale, 0.0, amax]);
     p[0] = p[0].max(1e-3 * fscale);
     p[1] = p[1].max(p[0] * 1.01 + 1e-6 * fscale);
     p[2] = p[2].max(1e-6 * fscale / amax.max(1e-300));
     p[3] = p[3].clamp(amin * 0.5, amax * 2.0);
     p
-}
-
-/// Least squares on the points IRLS kept, re-checking the rejections (`|e| > k1*s`,
-/// `s` the robust scale of all residuals at the refit) until the kept set settles.
-fn refit_kept(
-    resid: &dyn Fn(&[f64]) -> Option<Vec<f64>>,
-    objective: &dyn Fn(&[f64], &[f64]) -> f64,
-    out: &mut IrlsOutcome,
-    k1: f64,
-    setup: &IrlsSetup,
-) {
-    let mut keep: Vec<f64> = out
-        .weights
-        .iter()
-        .map(|w| if *w > 0.0 { 1.0 } else { 0.0 })
-        .collect();
-    let step: Vec<f64> = setup.step.iter().map(|s| 0.1 * s).collect();
-    for _ in 0..5 {
-        if keep.iter().sum::<f64>() < MIN_POINTS_PER_DIRECTION as f64 {
-            return;
-        }
-        let mut f = |th: &[f64]| match resid(th) {
-            Some(r) => objective(&r, &keep),
-            None => f64::INFINITY,
-        };
-        let r = minimize(&mut f, &out.theta, &step, &setup.nm);
-        out.evals += r.evals + 1;
-        let Some(e) = resid(&r.x) else {
-            return;
-        };
-        // scale of the kept points (n_kept - 4 degrees of freedom), made consistent for
-        // a Gaussian truncated at +-k1: more efficient than the MAD of all residuals,
-        // whose noise in a small sample moves the rejection threshold
-        let n_kept = keep.iter().sum::<f64>();
-        let ss: f64 = e.iter().zip(&keep).map(|(ei, wi)| wi * ei * ei).sum();
-        let phi = (-0.5 * k1 * k1).exp() / (2.0 * std::f64::consts::PI).sqrt();
-        let var_factor = 1.0 - 2.0 * k1 * phi / libm::erf(k1 / std::f64::consts::SQRT_2);
-        let s = (ss / (n_kept - 4.0) / var_factor)
-            .sqrt()
-            .max(setup.scale_floor);
-        let new_keep: Vec<f64> = e
-            .iter()
-            .map(|ei| if ei.abs() <= k1 * s { 1.0 } else { 0.0 })
-            .collect();
-        out.theta = r.x;
-        out.residuals = e;
-        out.scale = s;
-        out.weights = keep.clone();
-        if new_keep == keep {
-            return;
-        }
-        keep = new_keep;
-    }
 }
 
 /// Fit one direction to magnitudes `a = |v|` and mirrored forces `y = sign(v)*F`.
@@ -429,35 +694,20 @@ fn fit_direction(
     notes: &mut Vec<String>,
     label: &str,
 ) -> Result<DirectionFit> {
-    let to_theta = |p: [f64; 4]| vec![p[0].ln(), (p[1] - p[0]).ln(), p[2].ln(), p[3].ln()];
-    let resid = |th: &[f64]| -> Option<Vec<f64>> {
-        let p = to_params(th);
-        if !p.iter().all(|v| v.is_finite() && *v > 0.0) {
-            return None;
-        }
-        Some(
-            a.iter()
-                .zip(y)
-                .map(|(&ai, &yi)| yi - curve(&p, ai))
-                .collect(),
-        )
-    };
-    let objective = |e: &[f64], w: &[f64]| e.iter().zip(w).map(|(ei, wi)| wi * ei * ei).sum();
-    let step = [0.1, 0.3, 0.1, 0.3];
-    let setup = IrlsSetup {
-        weighting: opts.weighting,
+    let fscale = median(&y.iter().map(|v| v.abs()).collect::<Vec<_>>()).max(1e-12);
+    let mut sep = Sep::new(a, y, fscale);
+    let scale_floor = opts.scale_floor.max(1e-6 * fscale);
+    let cfg = Cfg {
         max_outer: opts.max_iter,
         tol: opts.tol,
-        scale_floor: opts
-            .scale_floor
-            .max(1e-6 * median(&y.iter().map(|v| v.abs()).collect::<Vec<_>>())),
+        scale_floor,
         nm: NmOptions {
             max_evals: opts.max_evals,
             xtol: 1e-10,
             ftol: 1e-14,
-            restarts: 1,
+            restarts: 0,
         },
-        step: &step,
+        obj_floor: 1e-6 * scale_floor * scale_floor,
     };
     let reject_at = match opts.weighting {
         Weighting::Igg { k1, .. } => Some(k1),
@@ -466,26 +716,22 @@ fn fit_direction(
     };
     // One path: from a start, an optional IRLS pass with another weight function,
     // IRLS, then (rejecting weight functions) the least-squares refit on the kept points.
-    let path = |p0: [f64; 4], pre: Option<Weighting>| -> Option<IrlsOutcome> {
-        let mut theta0 = to_theta(p0);
+    let path = |sep: &mut Sep, p0: [f64; 4], pre: Option<Weighting>| -> Outcome {
+        let mut p0 = p0;
         let mut evals = 0;
         if let Some(w) = pre {
-            let pre = IrlsSetup {
-                weighting: w,
-                ..setup
-            };
-            if let Some(o) = irls(&resid, &objective, theta0.clone(), &pre) {
-                theta0 = o.theta;
-                evals = o.evals;
-            }
+            let o = irls_vp(sep, p0, w, &cfg);
+            p0 = o.p;
+            evals = o.evals;
         }
-        let mut out = irls(&resid, &objective, theta0, &setup)?;
+        let mut out = irls_vp(sep, p0, opts.weighting, &cfg);
         out.evals += evals;
         if let (true, Some(k1)) = (opts.refit_kept, reject_at) {
-            refit_kept(&resid, &objective, &mut out, k1, &setup);
+            refit_kept(sep, &mut out, k1, &cfg);
         }
-        Some(out)
+        out
     };
+    let huber_start = clamp_start(start_values_huber(&mut sep), a, fscale);
     let out = if reject_at.is_some() {
         // Redescending weights (IGG, Tukey) settle on the set of rejected points near
         // their start. Two starts, as in MM-estimation (Yohai 1987): (a) a Huber pass
@@ -494,52 +740,53 @@ fn fit_direction(
         // (the fastest and slowest points) that a Huber fit follows. The fit with the
         // smaller bounded (Tukey) loss at a common scale wins, as in the choice among
         // local minima of an MM-estimate.
-        let a_fit = path(start_values_huber(a, y), Some(Weighting::huber()));
-        let b_fit = path(start_values_lts(a, y), Some(Weighting::tukey()));
-        match (a_fit, b_fit) {
-            (Some(fa), Some(fb)) => {
-                // Tukey's rho at a common scale (the smaller robust scale of the two):
-                // a rejected point costs the same in both, a kept one its misfit
-                let s = robust_scale(&fa.residuals)
-                    .min(robust_scale(&fb.residuals))
-                    .max(setup.scale_floor);
-                let c = 4.685;
-                let rho = |o: &IrlsOutcome| -> f64 {
-                    o.residuals
-                        .iter()
-                        .map(|e| {
-                            let u = (e / (c * s)).abs().min(1.0);
-                            1.0 - (1.0 - u * u).powi(3)
-                        })
-                        .sum()
-                };
-                let evals = fa.evals + fb.evals;
-                let mut best = if rho(&fb) < rho(&fa) { fb } else { fa };
-                best.evals = evals;
-                Some(best)
-            }
-            (fa, fb) => fa.or(fb),
-        }
+        let fa = path(&mut sep, huber_start, Some(Weighting::huber()));
+        let lts_start = clamp_start(start_values_lts(&mut sep), a, fscale);
+        let fb = path(&mut sep, lts_start, Some(Weighting::tukey()));
+        // Tukey's rho at a common scale (the smaller robust scale of the two): a
+        // rejected point costs the same in both, a kept one its misfit
+        let s = robust_scale(&fa.residuals)
+            .min(robust_scale(&fb.residuals))
+            .max(scale_floor);
+        let c = 4.685;
+        let rho = |o: &Outcome| -> f64 {
+            o.residuals
+                .iter()
+                .map(|e| {
+                    let u = (e / (c * s)).abs().min(1.0);
+                    1.0 - (1.0 - u * u).powi(3)
+                })
+                .sum()
+        };
+        let evals = fa.evals + fb.evals;
+        let mut best = if rho(&fb) < rho(&fa) { fb } else { fa };
+        best.evals = evals;
+        best
     } else {
-        path(start_values_huber(a, y), None)
+        path(&mut sep, huber_start, None)
     };
-    let out = out.ok_or_else(|| {
-        Error::Data(format!(
+    if !out.p.iter().all(|v| v.is_finite()) {
+        return Err(Error::Data(format!(
             "{label} direction: the Stribeck curve could not be evaluated at the start values; check the data for extreme values"
-        ))
-    })?;
-    let p = to_params(&out.theta);
-    // covariance from the weighted Jacobian at the optimum
-    let n = a.len();
-    let mut j = DMatrix::<f64>::zeros(n, 4);
-    for (i, &ai) in a.iter().enumerate() {
-        let phi = (-(ai / p[3]).powi(2)).exp();
-        j[(i, 0)] = 1.0 - phi;
-        j[(i, 1)] = phi;
-        j[(i, 2)] = ai;
-        j[(i, 3)] = (p[1] - p[0]) * phi * 2.0 * ai * ai / (p[3] * p[3] * p[3]);
+        )));
     }
-    let wv = DVector::from_vec(out.weights.clone());
+    let p = out.p;
+    // covariance from the weighted Jacobian at the optimum
+    let mut jtwj = Matrix4::<f64>::zeros();
+    for (i, &ai) in a.iter().enumerate() {
+        let wi = out.weights[i];
+        if wi == 0.0 {
+            continue;
+        }
+        let phi = (-(ai / p[3]).powi(2)).exp();
+        let r = Vector4::new(
+            1.0 - phi,
+            phi,
+            ai,
+            (p[1] - p[0]) * phi * 2.0 * ai * ai / (p[3] * p[3] * p[3]),
+        );
+        jtwj += wi * r * r.transpose();
+    }
     let n_used = out.weights.iter().filter(|w| **w > 0.0).count();
     let dof = n_used as f64 - 4.0;
     let ssq: f64 = out
@@ -553,18 +800,13 @@ fn fit_direction(
     } else {
         f64::NAN
     };
-    let mut jtwj = DMatrix::<f64>::zeros(4, 4);
-    for i in 0..n {
-        let r = j.row(i);
-        jtwj += wv[i] * r.transpose() * r;
-    }
-    let d: Vec<f64> = (0..4).map(|k| jtwj[(k, k)].sqrt()).collect();
+    let d = Vector4::from_fn(|k, _| jtwj[(k, k)].sqrt());
     let mut std_err = vec![f64::NAN; 4];
     if d.iter().all(|x| *x > 0.0 && x.is_finite()) && sigma.is_finite() {
-        let dm = DMatrix::from_diagonal(&DVector::from_iterator(4, d.iter().map(|x| 1.0 / x)));
-        let m = &dm * &jtwj * &dm;
+        let dm = Matrix4::from_diagonal(&d.map(|x| 1.0 / x));
+        let m = dm * jtwj * dm;
         if let Some(inv) = m.try_inverse() {
-            let cov = &dm * inv * &dm * (sigma * sigma);
+            let cov = dm * inv * dm * (sigma * sigma);
             for (k, se) in std_err.iter_mut().enumerate() {
                 let v = cov[(k, k)];
                 if v >= 0.0 {
