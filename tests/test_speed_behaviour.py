@@ -153,13 +153,23 @@ def test_ctrl_c_interrupts_simulate(speed: float) -> None:
     assert elapsed < 2.0, f"interrupted after {elapsed:.2f} s of a ~10 s run"
 
 
-@pytest.mark.xfail(reason="simulate_batch does not poll for Ctrl-C yet: it finishes the batch",
-                   strict=False)
 def test_ctrl_c_interrupts_simulate_batch(speed: float) -> None:
     steps = int(min(max(speed, 1e5), 3e7) * 1.5)
     t, xr = _grid(steps)
     models = [lugre.Model.paper()] * 4
     elapsed = _time_to_interrupt(lambda: lugre.simulate_batch(models, t, xr), after=0.3)
+    assert elapsed < 1.5, f"interrupted after {elapsed:.2f} s"
+
+
+def test_ctrl_c_interrupts_fit_dynamic() -> None:
+    plant = lugre.Model.paper().replace(
+        controller={"type": "pid", "kp": 2e4, "ki": 2e4, "kd": 0.0, "rate_hz": 1e4})
+    t = np.arange(0.0, 40.0, 1e-4)  # a long record: the fit takes many seconds
+    x_ref = 5e-3 * (t % 4.0) * np.where((t % 8.0) < 4.0, 1.0, -1.0)
+    r = lugre.simulate(plant, t, x_ref)
+    rec = lugre.Recording(t=t, x=np.round(r.x / 1e-6) * 1e-6, i=r.i, x_ref=x_ref)
+    start = plant.with_friction(sigma0=3e4, sigma1=100.0)
+    elapsed = _time_to_interrupt(lambda: lugre.fit_dynamic(rec, start), after=0.3)
     assert elapsed < 1.5, f"interrupted after {elapsed:.2f} s"
 
 

@@ -21,6 +21,7 @@ use super::robust::{robust_scale, Weighting};
 use crate::error::{check_finite, check_len, check_time, Error, Result};
 use crate::servo::{simulate, ControlLaw, Drive, Model, SimOptions};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Options of [`fit_dynamic`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -308,6 +309,34 @@ pub fn fit_dynamic(
     x_measured: &[f64],
     opts: &DynamicFitOptions,
 ) -> Result<DynamicFit> {
+    fit_dynamic_with(model, t, x_ref, x_measured, opts, &AtomicBool::new(false))
+}
+
+/// As [`fit_dynamic`], stopping with [`Error::Interrupted`] once `cancel` is set (from
+/// another thread, e.g. on Ctrl-C).
+pub fn fit_dynamic_with(
+    model: &Model,
+    t: &[f64],
+    x_ref: &[f64],
+    x_measured: &[f64],
+    opts: &DynamicFitOptions,
+    cancel: &AtomicBool,
+) -> Result<DynamicFit> {
+    let r = fit_dynamic_body(model, t, x_ref, x_measured, opts, cancel);
+    if cancel.load(Ordering::Relaxed) {
+        return Err(Error::Interrupted);
+    }
+    r
+}
+
+fn fit_dynamic_body(
+    model: &Model,
+    t: &[f64],
+    x_ref: &[f64],
+    x_measured: &[f64],
+    opts: &DynamicFitOptions,
+    cancel: &AtomicBool,
+) -> Result<DynamicFit> {
     check_time("t", t)?;
     check_len("x_ref", x_ref, t.len(), "t")?;
     check_len("x_measured", x_measured, t.len(), "t")?;
@@ -343,11 +372,14 @@ pub fn fit_dynamic(
 
     let resid = |th: &[f64]| -> Option<Vec<f64>> {
         let (s0, s1) = (th[0].exp(), th[1].exp());
-        if !(s0.is_finite() && s1.is_finite() && s0 > 0.0) {
+        if cancel.load(Ordering::Relaxed) || !(s0.is_finite() && s1.is_finite() && s0 > 0.0) {
             return None;
         }
         let m = with_sigmas(model, s0, s1);
-        let r = simulate(&m, t, Drive::Position(x_ref), &sim_opts, &mut || true).ok()?;
+        let r = simulate(&m, t, Drive::Position(x_ref), &sim_opts, &mut || {
+            !cancel.load(Ordering::Relaxed)
+        })
+        .ok()?;
         Some(x_measured.iter().zip(&r.x).map(|(a, b)| a - b).collect())
     };
     let (c1, c2) = (opts.c1, opts.c2);

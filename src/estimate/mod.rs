@@ -17,7 +17,7 @@ pub mod plateaus;
 pub mod robust;
 pub mod static_fit;
 
-pub use dynamic_fit::{fit_dynamic, DynamicFit, DynamicFitOptions};
+pub use dynamic_fit::{fit_dynamic, fit_dynamic_with, DynamicFit, DynamicFitOptions};
 pub use plateaus::{plateaus_from_recording, PlateauOptions, Plateaus};
 pub use robust::{median, quantile, robust_scale, Weighting};
 pub use static_fit::{fit_static, DirectionFit, StaticFit, StaticFitOptions};

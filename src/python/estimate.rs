@@ -1,10 +1,10 @@
 //! Bindings of the estimators: convert in, run with the interpreter released, convert
 //! the plain-data results into dicts of arrays and numbers.
 
-use super::{parse_model, slice, to_py};
+use super::{interruptible, parse_model, slice, to_py};
 use crate::error::Error;
 use crate::estimate::{
-    fit_dynamic, fit_static, plateaus_from_recording, DirectionFit, DynamicFitOptions,
+    fit_dynamic_with, fit_static, plateaus_from_recording, DirectionFit, DynamicFitOptions,
     PlateauOptions, StaticFitOptions, Weighting,
 };
 use crate::servo::Integrator;
@@ -159,7 +159,7 @@ pub(crate) fn fit_dynamic_record<'py>(
             }
         };
         let (t, xr, xm) = (slice("t", &t)?, slice("x_ref", &x_ref)?, slice("x", &x)?);
-        py.detach(|| fit_dynamic(&m, t, xr, xm, &opts))
+        interruptible(py, |cancel| fit_dynamic_with(&m, t, xr, xm, &opts, cancel))
     })()
     .map_err(|e| to_py(py, e))?;
     let o = PyDict::new(py);

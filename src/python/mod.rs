@@ -8,6 +8,9 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::RecvTimeoutError;
+use std::time::Duration;
 
 mod estimate;
 
@@ -47,6 +50,40 @@ pub(crate) fn slice<'a>(name: &str, a: &'a PyReadonlyArray1<'_, f64>) -> Result<
 
 pub(crate) fn parse_model(py: Python<'_>, text: &str) -> PyResult<Model> {
     Model::from_json(text).map_err(|e| to_py(py, e))
+}
+
+/// Run `work` on a scoped thread with the interpreter released, while this thread
+/// polls for Ctrl-C every 20 ms and sets the cancel flag that `work` watches.
+pub(crate) fn interruptible<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce(&AtomicBool) -> T + Send,
+) -> T {
+    let cancel = AtomicBool::new(false);
+    py.detach(|| {
+        std::thread::scope(|s| {
+            let (tx, rx) = std::sync::mpsc::channel();
+            let cancel = &cancel;
+            s.spawn(move || {
+                let _ = tx.send(work(cancel));
+            });
+            loop {
+                match rx.recv_timeout(Duration::from_millis(20)) {
+                    Ok(r) => return r,
+                    Err(RecvTimeoutError::Timeout) => {
+                        if !cancel.load(Ordering::Relaxed)
+                            && Python::attach(|py| py.check_signals().is_err())
+                        {
+                            cancel.store(true, Ordering::Relaxed);
+                        }
+                    }
+                    // the worker panicked: let the scope re-raise it
+                    Err(RecvTimeoutError::Disconnected) => {
+                        std::panic::resume_unwind(Box::new("worker thread failed"))
+                    }
+                }
+            }
+        })
+    })
 }
 
 /// Validate a model given as JSON text; returns whether its friction is passive.
@@ -171,8 +208,7 @@ fn result_dict<'py>(py: Python<'py>, r: SimResult) -> PyResult<Bound<'py, PyDict
 
 /// Simulate the axis; returns a dict of arrays (x, v, z, i, friction, force).
 ///
-/// Runs with the interpreter released and checks for Ctrl-C every 65,536 control
-/// periods.
+/// Runs with the interpreter released and checks for Ctrl-C about every 50 ms.
 #[pyfunction]
 #[pyo3(signature = (model_json, t, drive_kind, drive, integrator="exact", substeps=1, z0=0.0, x0=None, v0=0.0))]
 #[allow(clippy::too_many_arguments)]
@@ -227,9 +263,11 @@ fn simulate_batch<'py>(
         let opts = parse_opts(integrator, substeps, z0, x0, v0)?;
         let ts = slice("t", &t)?;
         let d = drive_of(drive_kind, slice(drive_kind, &drive)?)?;
-        py.detach(|| servo::simulate_batch(&models, ts, d, &opts))
-            .into_iter()
-            .collect()
+        interruptible(py, |cancel| {
+            servo::simulate_batch_with(&models, ts, d, &opts, cancel)
+        })
+        .into_iter()
+        .collect()
     })()
     .map_err(|e| to_py(py, e))?;
     results.into_iter().map(|r| result_dict(py, r)).collect()

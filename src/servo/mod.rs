@@ -6,4 +6,6 @@ pub mod sim;
 pub use model::{
     Axis, ControlLaw, Controller, CurrentLoop, Effect, Feedforward, FeedforwardKind, Model,
 };
-pub use sim::{simulate, simulate_batch, Drive, Integrator, SimOptions, SimResult};
+pub use sim::{
+    simulate, simulate_batch, simulate_batch_with, Drive, Integrator, SimOptions, SimResult,
+};

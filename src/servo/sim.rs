@@ -13,6 +13,7 @@ use crate::error::{check_finite, check_len, check_time, Error, Result};
 use crate::friction::{Compensator, LugreParams};
 use std::collections::VecDeque;
 use std::f64::consts::PI;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// How often a long simulation calls its `keep_going` callback (for Ctrl-C in Python).
@@ -754,9 +755,21 @@ pub fn simulate_batch(
     drive: Drive,
     opts: &SimOptions,
 ) -> Vec<Result<SimResult>> {
+    simulate_batch_with(models, t, drive, opts, &AtomicBool::new(false))
+}
+
+/// As [`simulate_batch`], stopping every run with [`Error::Interrupted`] once `cancel`
+/// is set (from another thread, e.g. on Ctrl-C).
+pub fn simulate_batch_with(
+    models: &[Model],
+    t: &[f64],
+    drive: Drive,
+    opts: &SimOptions,
+    cancel: &AtomicBool,
+) -> Vec<Result<SimResult>> {
     use rayon::prelude::*;
     models
         .par_iter()
-        .map(|m| simulate(m, t, drive, opts, &mut || true))
+        .map(|m| simulate(m, t, drive, opts, &mut || !cancel.load(Ordering::Relaxed)))
         .collect()
 }
