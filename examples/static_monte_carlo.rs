@@ -78,6 +78,7 @@ fn main() {
     let mut outlier_recall = vec![0usize; schemes.len()];
     let mut fit_time = vec![0.0f64; schemes.len()];
     let mut false_reject = vec![0usize; schemes.len()];
+    let mut evals = vec![0usize; schemes.len()];
     let mut n_outliers = 0usize;
     let mut rng = Rng(seed);
     let t0 = std::time::Instant::now();
@@ -126,6 +127,7 @@ fn main() {
                 }
             };
             worst[k].push(worst_error(&fit, &pos, &neg));
+            evals[k] += fit.positive.evaluations + fit.negative.evaluations;
             for &r in &fit.rejected {
                 if is_out[r] {
                     outlier_recall[k] += 1;
@@ -145,16 +147,17 @@ fn main() {
         n_outliers,
         t0.elapsed().as_secs_f64()
     );
-    println!("weighting   median worst rel. err  p95 worst rel. err  outliers rejected  clean points rejected  ms per fit");
+    println!("weighting   median worst rel. err  p95 worst rel. err  outliers rejected  clean points rejected  ms per fit  evaluations per fit");
     for (k, (name, _)) in schemes.iter().enumerate() {
         println!(
-            "{:<10}  {:>19.3} %  {:>16.3} %  {:>17}  {:>21}  {:>10.2}",
+            "{:<10}  {:>19.3} %  {:>16.3} %  {:>17}  {:>21}  {:>10.3}  {:>19.0}",
             name,
             100.0 * quantile(&worst[k], 0.5),
             100.0 * quantile(&worst[k], 0.95),
             outlier_recall[k],
             false_reject[k],
-            1e3 * fit_time[k] / n_sets as f64
+            1e3 * fit_time[k] / n_sets as f64,
+            evals[k] as f64 / n_sets as f64
         );
     }
 }

@@ -4,14 +4,17 @@
 //! For `v > 0` the model is `F = fc + (fs - fc)*exp(-(v/vs)^2) + sigma2*v` (eq. 7);
 //! for `v < 0` the same curve mirrored, `F = -(fc + ...) + sigma2*v`, with its own
 //! positive parameters (eq. 9). Each direction is fitted separately by robust IRLS
-//! (eqs. 19-24) with Nelder-Mead on `(ln fc, ln(fs - fc), ln sigma2, ln vs)`: the
-//! log-parameters are of order one whatever the units, and `fs >= fc`, all positive,
-//! hold by construction.
+//! (eqs. 19-24). For a fixed `vs` the curve is linear in `(fc, fs - fc, sigma2)`:
+//! each weighted problem is solved by variable projection (separable least squares,
+//! Golub and Pereyra 1973), the linear parameters in closed form from the 3x3 normal
+//! equations (column-scaled Cholesky; `fc > 0`, `fs >= fc`, `sigma2 >= 0` by an
+//! exhaustive active set when the unconstrained solution violates them), so the
+//! nonlinear search is over `ln vs` alone: a bracket walked downhill, then Nelder-Mead
+//! from the vertex of its parabola.
 //!
 //! Start values need no user input: for a fixed `vs` the curve is linear in
 //! `(fc, fs, sigma2)`, so a grid over `ln vs` with a robust linear fit at each node
-//! gives a start that gross errors do not pull away (a variable-projection start,
-//! Golub and Pereyra 1973). With a rejecting weight function (IGG, Tukey) two such
+//! gives a start that gross errors do not pull away. With a rejecting weight function (IGG, Tukey) two such
 //! starts are followed to the end, a Huber grid and a least-trimmed-squares grid (the
 //! latter also resists gross errors at the fastest or slowest speeds, which have high
 //! leverage), and the fit with the smaller bounded loss is returned; the
@@ -127,7 +130,8 @@ fn fill_phi(a: &[f64], vs: f64, phi: &mut [f64]) {
     let iv = 1.0 / vs;
     for (p, &ai) in phi.iter_mut().zip(a) {
         let r = ai * iv;
-        *p = (-(r * r)).exp();
+        // below exp(-40) = 4e-18 the term is under the rounding of the force
+        *p = if r * r < 40.0 { (-(r * r)).exp() } else { 0.0 };
     }
 }
 
@@ -155,62 +159,61 @@ impl Normal {
     }
 
     /// Solve on the free unknowns (`free` bit k set) with the others held at zero, by
-    /// Cholesky of the column-scaled system; `None` when (nearly) singular.
+    /// Cholesky of the column-scaled system (unit diagonal); `None` when (nearly)
+    /// singular.
     fn solve_free(&self, free: u8) -> Option<[f64; 3]> {
-        let mut idx = [0usize; 3];
-        let mut k = 0;
-        for (j, slot) in (0..3).filter(|j| free & (1 << j) != 0).zip(0..) {
-            idx[slot] = j;
-            k = slot + 1;
-        }
+        const PIVOT: f64 = 1e-13;
+        let m = &self.m;
+        let inv_sqrt = |v: f64| (v > 0.0 && v.is_finite()).then(|| 1.0 / v.sqrt());
         let mut x = [0.0; 3];
-        if k == 0 {
-            return Some(x);
-        }
-        let mut d = [0.0; 3];
-        for r in 0..k {
-            let mrr = self.m[idx[r]][idx[r]];
-            if !(mrr > 0.0 && mrr.is_finite()) {
-                return None;
-            }
-            d[r] = 1.0 / mrr.sqrt();
-        }
-        let at = |r: usize, c: usize| {
-            let (i, j) = (idx[r].min(idx[c]), idx[r].max(idx[c]));
-            self.m[i][j] * d[r] * d[c]
-        };
-        // Cholesky L L^T of the scaled matrix (unit diagonal before factoring)
-        let mut l = [[0.0; 3]; 3];
-        for r in 0..k {
-            for c in 0..=r {
-                let mut s = at(r, c);
-                for q in 0..c {
-                    s -= l[r][q] * l[c][q];
+        match free {
+            0b111 => {
+                let (d0, d1, d2) = (inv_sqrt(m[0][0])?, inv_sqrt(m[1][1])?, inv_sqrt(m[2][2])?);
+                let (a, b, c) = (m[0][1] * d0 * d1, m[0][2] * d0 * d2, m[1][2] * d1 * d2);
+                let p1 = 1.0 - a * a;
+                if p1.is_nan() || p1 <= PIVOT {
+                    return None;
                 }
-                if r == c {
-                    if s <= 1e-13 {
-                        return None;
-                    }
-                    l[r][r] = s.sqrt();
-                } else {
-                    l[r][c] = s / l[c][c];
+                let l11 = p1.sqrt();
+                let l21 = (c - a * b) / l11;
+                let p2 = 1.0 - b * b - l21 * l21;
+                if p2.is_nan() || p2 <= PIVOT {
+                    return None;
                 }
+                let l22 = p2.sqrt();
+                let z0 = self.b[0] * d0;
+                let z1 = (self.b[1] * d1 - a * z0) / l11;
+                let z2 = (self.b[2] * d2 - b * z0 - l21 * z1) / l22;
+                let u2 = z2 / l22;
+                let u1 = (z1 - l21 * u2) / l11;
+                let u0 = z0 - a * u1 - b * u2;
+                x = [u0 * d0, u1 * d1, u2 * d2];
             }
-        }
-        let mut z = [0.0; 3];
-        for r in 0..k {
-            let mut s = self.b[idx[r]] * d[r];
-            for q in 0..r {
-                s -= l[r][q] * z[q];
+            0b011 | 0b101 | 0b110 => {
+                let (i, j) = match free {
+                    0b011 => (0, 1),
+                    0b101 => (0, 2),
+                    _ => (1, 2),
+                };
+                let (di, dj) = (inv_sqrt(m[i][i])?, inv_sqrt(m[j][j])?);
+                let a = m[i][j] * di * dj;
+                let det = 1.0 - a * a;
+                if det.is_nan() || det <= PIVOT {
+                    return None;
+                }
+                let (bi, bj) = (self.b[i] * di, self.b[j] * dj);
+                x[i] = (bi - a * bj) / det * di;
+                x[j] = (bj - a * bi) / det * dj;
             }
-            z[r] = s / l[r][r];
-        }
-        for r in (0..k).rev() {
-            let mut s = z[r];
-            for q in r + 1..k {
-                s -= l[q][r] * x[idx[q]] / d[q];
+            0b001 | 0b010 | 0b100 => {
+                let i = free.trailing_zeros() as usize;
+                let mii = m[i][i];
+                if !(mii > 0.0 && mii.is_finite()) {
+                    return None;
+                }
+                x[i] = self.b[i] / mii;
             }
-            x[idx[r]] = s / l[r][r] * d[r];
+            _ => {}
         }
         x.iter().all(|v| v.is_finite()).then_some(x)
     }
@@ -281,9 +284,9 @@ impl<'a> Sep<'a> {
     /// Normal equations at the `phi` in the buffer.
     fn normal(&self, w: &[f64]) -> Normal {
         let mut ne = Normal::default();
-        for i in 0..self.a.len() {
-            if w[i] != 0.0 {
-                ne.add(self.phi[i], self.a[i], self.y[i] - self.fc_min, w[i]);
+        for (((&phi, &a), &y), &wi) in self.phi.iter().zip(self.a).zip(self.y).zip(w) {
+            if wi != 0.0 {
+                ne.add(phi, a, y - self.fc_min, wi);
             }
         }
         ne
@@ -306,9 +309,9 @@ impl<'a> Sep<'a> {
         let p = self.params(&x, vs);
         let d = p[1] - p[0];
         let mut ss = 0.0;
-        for i in 0..self.a.len() {
-            let e = self.y[i] - (p[0] + d * self.phi[i] + p[2] * self.a[i]);
-            ss += w[i] * e * e;
+        for (((&phi, &a), &y), &wi) in self.phi.iter().zip(self.a).zip(self.y).zip(w) {
+            let e = y - (p[0] + d * phi + p[2] * a);
+            ss += wi * e * e;
         }
         (ss, p)
     }
@@ -334,10 +337,50 @@ fn vp_minimize(
 ) -> ([f64; 4], usize) {
     // `floor` (a constant) makes the relative stopping rule of the simplex absolute
     // near a zero sum of squares (noise-free data)
-    let mut f = |x: &[f64]| sep.profile(w, x[0]).0 + floor;
-    let r = minimize(&mut f, &[ln_vs0], &[step], nm);
+    let mut f = |x: f64| sep.profile(w, x).0 + floor;
+    // bracket: three nodes `step` apart, moved downhill with a doubling step until
+    // the middle one is the lowest
+    let (mut xa, mut xb, mut xc) = (ln_vs0 - step, ln_vs0, ln_vs0 + step);
+    let (mut fa, mut fb, mut fc) = (f(xa), f(xb), f(xc));
+    let mut evals = 3;
+    let mut h = step;
+    while evals < 40 {
+        if fa < fb && fa <= fc {
+            h *= 2.0;
+            (xc, fc, xb, fb) = (xb, fb, xa, fa);
+            xa = xb - h;
+            fa = f(xa);
+        } else if fc < fb {
+            h *= 2.0;
+            (xa, fa, xb, fb) = (xb, fb, xc, fc);
+            xc = xb + h;
+            fc = f(xc);
+        } else {
+            break;
+        }
+        evals += 1;
+    }
+    // Nelder-Mead from the vertex of the parabola through the bracket (the best node
+    // when that is not lower), with a small simplex: the parabola is close to the
+    // minimum of the smooth profile, and the simplex expands if it is not
+    let (da, dc) = (xb - xa, xb - xc);
+    let den = da * (fb - fc) - dc * (fb - fa);
+    let mut x0 = xb;
+    if den != 0.0 && den.is_finite() {
+        let xp = xb - 0.5 * (da * da * (fb - fc) - dc * dc * (fb - fa)) / den;
+        if xp > xa && xp < xc {
+            let fp = f(xp);
+            evals += 1;
+            if fp < fb {
+                x0 = xp;
+            }
+        }
+    }
+    let simplex = (1e-3 * h).max(1e-7);
+    let mut g = |x: &[f64]| f(x[0]);
+    let r = minimize(&mut g, &[x0], &[simplex], nm);
     let (_, p) = sep.profile(w, r.x[0]);
-    (p, r.evals + 1)
+    (p, evals + r.evals + 1)
 }
 
 /// Outcome of one IRLS path.
@@ -351,12 +394,27 @@ struct Outcome {
     evals: usize,
 }
 
+/// Role of an IRLS run.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Stage {
+    /// A pass that only provides the start of the next one: weights settled to 1e-2.
+    Pre,
+    /// Followed by the least-squares refit of the kept points.
+    Refit,
+    /// The result: the last weighted problem is solved again to full precision.
+    Polish,
+}
+
 /// Settings shared by the IRLS runs of one direction.
 struct Cfg {
     max_outer: usize,
     tol: f64,
     scale_floor: f64,
     nm: NmOptions,
+    /// Looser simplex tolerance of the IRLS rounds (whose weights change again).
+    nm_loose: NmOptions,
+    /// Loosest tolerance, for the passes that only give the start of the next.
+    nm_pre: NmOptions,
     /// Added to the profile objective (see [`vp_minimize`]).
     obj_floor: f64,
 }
@@ -372,7 +430,7 @@ fn max_rel_change(p: &[f64; 4], q: &[f64; 4]) -> f64 {
 /// IRLS (eqs. 19-24): weights from the residuals at the current parameters and their
 /// robust scale, then the weighted profile minimised over `ln vs`, until the weights
 /// or the parameters settle.
-fn irls_vp(sep: &mut Sep, p0: [f64; 4], weighting: Weighting, cfg: &Cfg) -> Outcome {
+fn irls_vp(sep: &mut Sep, p0: [f64; 4], weighting: Weighting, cfg: &Cfg, stage: Stage) -> Outcome {
     let mut p = p0;
     let mut e = sep.residuals(&p);
     let scale_of = |e: &[f64]| robust_scale(e).max(cfg.scale_floor);
@@ -384,9 +442,15 @@ fn irls_vp(sep: &mut Sep, p0: [f64; 4], weighting: Weighting, cfg: &Cfg) -> Outc
     let mut step = 0.3;
     while iterations < cfg.max_outer.max(1) {
         iterations += 1;
-        let (pn, ev) = vp_minimize(sep, &w, p[3].ln(), step, &cfg.nm, cfg.obj_floor);
+        let nm = if stage == Stage::Pre {
+            &cfg.nm_pre
+        } else {
+            &cfg.nm_loose
+        };
+        let (pn, ev) = vp_minimize(sep, &w, p[3].ln(), step, nm, cfg.obj_floor);
         evals += ev;
         let dtheta = max_rel_change(&p, &pn);
+        let d_ln_vs = (pn[3] / p[3]).ln().abs();
         p = pn;
         e = sep.residuals(&p);
         s = scale_of(&e);
@@ -398,12 +462,22 @@ fn irls_vp(sep: &mut Sep, p0: [f64; 4], weighting: Weighting, cfg: &Cfg) -> Outc
             .fold((0.0f64, 0.0), |(m, t), d| (m.max(d), t + d));
         let dw_mean = dw_sum / w.len().max(1) as f64;
         w = w_new;
-        if dw <= 1e-3 || dw_mean <= 1e-5 || dtheta <= cfg.tol {
+        let dw_tol = if stage == Stage::Pre { 1e-2 } else { 1e-3 };
+        if dw <= dw_tol || dw_mean <= 1e-5 || dtheta <= cfg.tol {
             converged = true;
             break;
         }
-        // later rounds start close to the answer
-        step = 0.03;
+        // later rounds start close to the answer: a simplex of a few times the last
+        // move (the simplex expands if that is too small)
+        step = (3.0 * d_ln_vs).clamp(1e-3, 0.1);
+    }
+    if stage == Stage::Polish {
+        // the weighted problem of the final weights to full precision
+        let (pn, ev) = vp_minimize(sep, &w, p[3].ln(), 1e-3, &cfg.nm, cfg.obj_floor);
+        evals += ev;
+        p = pn;
+        e = sep.residuals(&p);
+        s = scale_of(&e);
     }
     Outcome {
         p,
@@ -432,7 +506,7 @@ fn refit_kept(sep: &mut Sep, out: &mut Outcome, k1: f64, cfg: &Cfg) {
         if n_kept < MIN_POINTS_PER_DIRECTION as f64 {
             return;
         }
-        let (p, ev) = vp_minimize(sep, &keep, out.p[3].ln(), 0.03, &cfg.nm, cfg.obj_floor);
+        let (p, ev) = vp_minimize(sep, &keep, out.p[3].ln(), 1e-3, &cfg.nm, cfg.obj_floor);
         out.evals += ev;
         let e = sep.residuals(&p);
         // scale of the kept points (n_kept - 4 degrees of freedom), made consistent for
@@ -481,7 +555,7 @@ fn grid_nodes(a: &[f64], count: usize) -> Vec<f64> {
 }
 
 /// Number of `ln vs` nodes of the start grids.
-const GRID_NODES: usize = 25;
+const GRID_NODES: usize = 17;
 
 /// Start values `(fc, fs, sigma2, vs)` from the `ln vs` grid (Huber).
 ///
@@ -500,11 +574,11 @@ fn start_values_huber(sep: &mut Sep) -> Option<[f64; 4]> {
         w.iter_mut().for_each(|v| *v = 1.0);
         let mut score = f64::INFINITY;
         let mut p = [f64::NAN; 4];
-        for it in 0..5 {
+        for it in 0..4 {
             p = sep.params(&sep.normal(&w).solve_nonneg(), vs);
             let d = p[1] - p[0];
-            for i in 0..n {
-                e[i] = sep.y[i] - (p[0] + d * sep.phi[i] + p[2] * sep.a[i]);
+            for (((ei, &phi), &a), &y) in e.iter_mut().zip(&sep.phi).zip(sep.a).zip(sep.y) {
+                *ei = y - (p[0] + d * phi + p[2] * a);
             }
             buf.iter_mut().zip(&e).for_each(|(b, x)| *b = *x);
             let med = median_mut(&mut buf);
@@ -512,7 +586,7 @@ fn start_values_huber(sep: &mut Sep) -> Option<[f64; 4]> {
                 .zip(&e)
                 .for_each(|(b, x)| *b = (x - med).abs());
             let s = (1.4826 * median_mut(&mut buf)).max(1e-12 * fscale);
-            if it == 4 {
+            if it == 3 {
                 buf.iter_mut().zip(&e).for_each(|(b, x)| *b = x.abs());
                 score = median_mut(&mut buf);
                 break;
@@ -529,22 +603,32 @@ fn start_values_huber(sep: &mut Sep) -> Option<[f64; 4]> {
 }
 
 /// Elemental subsets (three distinct indices below `n`) from a fixed-seed generator,
-/// so that fits are reproducible.
-fn elemental_seeds(n: usize, count: usize) -> Vec<[usize; 3]> {
+/// so that fits are reproducible: one point from each third of the speed range (by
+/// rank), so that the three rows determine the level at low speed, the Coulomb level
+/// and the viscous slope.
+fn elemental_seeds(a: &[f64], count: usize) -> Vec<[usize; 3]> {
+    let n = a.len();
+    let mut by_speed: Vec<usize> = (0..n).collect();
+    by_speed.sort_by(|&i, &j| a[i].total_cmp(&a[j]));
     let mut state = 0x2545_F491_4F6C_DD1Du64;
-    let mut next = || {
+    let mut next = |m: usize| {
         state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = state;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) % n as u64) as usize
+        ((z ^ (z >> 31)) % m.max(1) as u64) as usize
     };
+    let (t1, t2) = (n / 3, (2 * n) / 3);
     let mut out = Vec::with_capacity(count);
-    while out.len() < count && n >= 3 {
-        let (i, j, k) = (next(), next(), next());
-        if i != j && j != k && i != k {
-            out.push([i, j, k]);
-        }
+    if t1 == 0 || t2 == t1 {
+        return out;
+    }
+    while out.len() < count {
+        out.push([
+            by_speed[next(t1)],
+            by_speed[t1 + next(t2 - t1)],
+            by_speed[t2 + next(n - t2)],
+        ]);
     }
     out
 }
@@ -592,7 +676,7 @@ impl Lts {
         let mut cur = p;
         for _ in 1..max_steps {
             let (o, nx) = self.cstep(sep, &next);
-            if !(o < obj * (1.0 - 1e-12)) {
+            if o.is_nan() || o >= obj * (1.0 - 1e-12) {
                 if o <= obj {
                     return (o, next);
                 }
@@ -626,7 +710,7 @@ fn start_values_lts(sep: &mut Sep) -> Option<[f64; 4]> {
     let h = (3 * n).div_ceil(4).min(n);
     const SEEDS_PER_NODE: usize = 3;
     let nodes = grid_nodes(sep.a, GRID_NODES);
-    let seeds = elemental_seeds(n, SEEDS_PER_NODE * nodes.len());
+    let seeds = elemental_seeds(sep.a, SEEDS_PER_NODE * nodes.len());
     let mut lts = Lts {
         h,
         r2: vec![0.0; n],
@@ -635,6 +719,8 @@ fn start_values_lts(sep: &mut Sep) -> Option<[f64; 4]> {
     let all: Vec<usize> = (0..n).collect();
     let mut prev: Option<Vec<usize>> = None;
     let mut global: Option<(f64, [f64; 4], Vec<usize>)> = None;
+    let mut node_subsets: Vec<Option<Vec<usize>>> = vec![None; nodes.len()];
+    let mut found_at = 0;
     for (k, &vs) in nodes.iter().enumerate() {
         fill_phi(sep.a, vs, &mut sep.phi);
         let mut starts: Vec<[f64; 4]> = Vec::with_capacity(SEEDS_PER_NODE + 3);
@@ -647,24 +733,41 @@ fn start_values_lts(sep: &mut Sep) -> Option<[f64; 4]> {
                 starts.push(Lts::fit(sep, s, vs));
             }
         }
-        for sd in &seeds[k * SEEDS_PER_NODE..(k + 1) * SEEDS_PER_NODE] {
+        for sd in seeds.iter().skip(k * SEEDS_PER_NODE).take(SEEDS_PER_NODE) {
             starts.push(Lts::fit(sep, sd, vs));
         }
-        let mut node_best: Option<(f64, [f64; 4], Vec<usize>)> = None;
+        // two concentration steps from each start, the best to convergence
+        let mut node_best: Option<(f64, [f64; 4])> = None;
         for p0 in starts {
-            let (obj, p) = lts.concentrate(sep, p0, 10);
-            if obj.is_finite() && node_best.as_ref().is_none_or(|b| obj < b.0) {
-                let mut sub = lts.order[..h].to_vec();
-                sub.sort_unstable();
-                node_best = Some((obj, p, sub));
+            let (obj, p) = lts.concentrate(sep, p0, 2);
+            if obj.is_finite() && node_best.is_none_or(|b| obj < b.0) {
+                node_best = Some((obj, p));
             }
         }
-        let Some(nb) = node_best else {
+        let Some((_, p)) = node_best else {
             continue;
         };
-        prev = Some(nb.2.clone());
-        if global.as_ref().is_none_or(|g| nb.0 < g.0) {
-            global = Some(nb);
+        let (obj, p) = lts.concentrate(sep, p, 8);
+        let mut sub = lts.order[..h].to_vec();
+        sub.sort_unstable();
+        node_subsets[k] = Some(sub.clone());
+        prev = Some(sub.clone());
+        if global.as_ref().is_none_or(|g| obj < g.0) {
+            global = Some((obj, p, sub));
+            found_at = k;
+        }
+    }
+    // the best subset carried back to the nodes visited before it was found (the
+    // later ones started from it)
+    let (_, _, best_sub) = global.clone()?;
+    for (k, &vs) in nodes.iter().enumerate().take(found_at) {
+        if node_subsets[k].as_ref() == Some(&best_sub) {
+            continue;
+        }
+        fill_phi(sep.a, vs, &mut sep.phi);
+        let (obj, p) = lts.concentrate(sep, Lts::fit(sep, &best_sub, vs), 8);
+        if obj.is_finite() && global.as_ref().is_none_or(|g| obj < g.0) {
+            global = Some((obj, p, best_sub.clone()));
         }
     }
     global.map(|g| g.1)
@@ -704,7 +807,19 @@ fn fit_direction(
         nm: NmOptions {
             max_evals: opts.max_evals,
             xtol: 1e-10,
-            ftol: 1e-14,
+            ftol: 1e-12,
+            restarts: 0,
+        },
+        nm_loose: NmOptions {
+            max_evals: opts.max_evals,
+            xtol: 1e-10,
+            ftol: 1e-7,
+            restarts: 0,
+        },
+        nm_pre: NmOptions {
+            max_evals: opts.max_evals,
+            xtol: 1e-10,
+            ftol: 1e-5,
             restarts: 0,
         },
         obj_floor: 1e-6 * scale_floor * scale_floor,
@@ -720,13 +835,15 @@ fn fit_direction(
         let mut p0 = p0;
         let mut evals = 0;
         if let Some(w) = pre {
-            let o = irls_vp(sep, p0, w, &cfg);
+            let o = irls_vp(sep, p0, w, &cfg, Stage::Pre);
             p0 = o.p;
             evals = o.evals;
         }
-        let mut out = irls_vp(sep, p0, opts.weighting, &cfg);
+        let refit = opts.refit_kept && reject_at.is_some();
+        let stage = if refit { Stage::Refit } else { Stage::Polish };
+        let mut out = irls_vp(sep, p0, opts.weighting, &cfg, stage);
         out.evals += evals;
-        if let (true, Some(k1)) = (opts.refit_kept, reject_at) {
+        if let (true, Some(k1)) = (refit, reject_at) {
             refit_kept(sep, &mut out, k1, &cfg);
         }
         out
