@@ -406,6 +406,8 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
             for j, k in enumerate(names):
                 share = static_var[j] / var[j]
                 was = identifiable[j]
+                # the combined verdict below supersedes the record-only one
+                notes = [n for n in notes if not n.startswith(f"{k} = ")]
                 identifiable[j] = bool(identifiable[j] and rel[j] <= 0.25)
                 notes.append(
                     f"{k}: with the static step's uncertainty carried over, the 95 % interval "
@@ -427,8 +429,10 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
     )
     for k in names:
         if not fit.identifiable[k]:
-            warnings.warn(f"{k} is not determined by this record: " + " ".join(fit.notes),
-                          IdentifiabilityWarning, stacklevel=2)
+            lo_k, hi_k = fit.ci95[k]
+            warnings.warn(f"{k} is not determined by this record (95 % interval "
+                          f"[{lo_k:.4g}, {hi_k:.4g}]); the fit's notes say which experiment "
+                          "would determine it", IdentifiabilityWarning, stacklevel=2)
     if not fit.converged:
         warnings.warn("dynamic fit: IRLS reached its iteration limit", ConvergenceWarning,
                       stacklevel=2)
