@@ -158,12 +158,18 @@ def simulate(
     SimResult
         ``t``, ``x``, ``v``, ``z``, ``i``, ``friction`` and ``force`` at ``t``.
     """
+    tt, args = _sim_args(t, x_ref, v_ref, current, integrator, substeps, z0, x0, v0)
+    return SimResult(t=tt.copy(), **_core.simulate(_json(model), tt, *args))
+
+
+def _sim_args(t: Any, x_ref: Any, v_ref: Any, current: Any, integrator: Any, substeps: Any,
+              z0: Any, x0: Any, v0: Any) -> tuple[np.ndarray, tuple[Any, ...]]:
+    """Normalised ``t`` and the core's positional arguments after the model."""
     tt = _array("t", t)
     kind, d = _drive(x_ref, v_ref, current)
-    sub = _substeps(substeps)
-    r = _core.simulate(_json(model), tt, kind, d, str(integrator), sub, _float("z0", z0),
-                       None if x0 is None else _float("x0", x0), _float("v0", v0))
-    return SimResult(t=tt.copy(), **r)
+    args = (kind, d, str(integrator), _substeps(substeps), _float("z0", z0),
+            None if x0 is None else _float("x0", x0), _float("v0", v0))
+    return tt, args
 
 
 def _substeps(substeps: Any) -> int:
@@ -194,12 +200,8 @@ def simulate_batch(
     list of SimResult
         One per model, in order.
     """
-    tt = _array("t", t)
-    kind, d = _drive(x_ref, v_ref, current)
-    sub = _substeps(substeps)
-    texts = [_json(m) for m in models]
-    rs = _core.simulate_batch(texts, tt, kind, d, str(integrator), sub, _float("z0", z0),
-                              None if x0 is None else _float("x0", x0), _float("v0", v0))
+    tt, args = _sim_args(t, x_ref, v_ref, current, integrator, substeps, z0, x0, v0)
+    rs = _core.simulate_batch([_json(m) for m in models], tt, *args)
     return [SimResult(t=tt.copy(), **r) for r in rs]
 
 
