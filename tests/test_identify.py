@@ -180,3 +180,19 @@ def test_cli_fit_dynamic(tmp_path):
                 "--resolution", "1e-6")
     assert r.returncode == 0, r.stderr
     assert abs(lugre.load_model(tmp_path / "m.json").sigma0 / 1e5 - 1) < 0.02
+
+
+EMPS = SHARED / "datasets" / "emps" / "emps_estimation.csv"
+
+
+@pytest.mark.skipif(not EMPS.is_file(), reason=f"EMPS data not found at {EMPS}")
+def test_cli_fit_on_real_emps_data(tmp_path):
+    """Real measurements: the general fit finds the benchmark's mass (95.1 kg by IDIM-LS)
+    and a force error no worse than the benchmark's per-direction model (3.11 %)."""
+    out = tmp_path / "emps.json"
+    r = run_cli("fit", str(EMPS), "--json", str(out))
+    assert r.returncode == 0, r.stderr
+    m = lugre.load_model(out)
+    assert abs(m.mass - 95.1) < 2.0
+    ev = lugre.evaluate(lugre.read_recording(EMPS), m)
+    assert ev["nrmse_force"] < 0.0311

@@ -141,7 +141,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 
 
 def _cmd_fit(args: argparse.Namespace) -> int:
-    from .diagnose import fit_inverse_dynamics
+    from .diagnose import diagnose, evaluate, fit_inverse_dynamics
     from .io import read_recording
     from .model import save_model
 
@@ -151,11 +151,25 @@ def _cmd_fit(args: argparse.Namespace) -> int:
         raise InputError.at("--force-constant", f"{args.recording} holds the current i: give "
                             "the force constant K_F [N/A] with --force-constant")
     model = fit_inverse_dynamics(rec, mass=args.mass, force_constant=args.force_constant or 1.0)
+    before = evaluate(rec, model)["nrmse_force"]
+    print(f"inverse dynamics (robust least squares, static friction curve): force nrmse "
+          f"{100 * before:.2f} %")
+    if not args.no_refine:
+        # refine every base parameter with the bristle state simulated along the measured
+        # velocity (the diagnosis's base re-estimation, with no extra physics)
+        refined = diagnose(rec, model, candidates=[]).augmented_model()
+        if args.mass:
+            refined = refined.replace(axis={**refined.axis, "mass": args.mass})
+        after = evaluate(rec, refined)["nrmse_force"]
+        print(f"refined with the LuGre state simulated along the measured velocity: force "
+              f"nrmse {100 * after:.2f} %")
+        if after < before:
+            model = refined
     for d in ("positive", "negative"):
         p = getattr(model, d)
         print(f"{d:8s} fc {p['fc']:.4g} N  fs {p['fs']:.4g} N  sigma2 {p['sigma2']:.4g} N s/m  "
               f"vs {p['vs']:.4g} m/s")
-    print(f"mass {model.mass:.4g} kg, sigma0 {model.sigma0:.4g} N/m (guess), "
+    print(f"mass {model.mass:.4g} kg, sigma0 {model.sigma0:.4g} N/m, sigma1 {model.sigma1:.4g} N s/m, "
           f"force constant {model.force_constant:.4g} N/A")
     save_model(model, args.json)
     print(f"model written to {args.json}")
@@ -240,6 +254,8 @@ def build_parser() -> argparse.ArgumentParser:
     ft.add_argument("--mass", type=float, help="known moving mass [kg] (estimated otherwise)")
     ft.add_argument("--force-constant", type=float,
                     help="K_F [N/A]; needed when the recording holds the current i")
+    ft.add_argument("--no-refine", action="store_true",
+                    help="stop after the inverse-dynamics least squares")
     ft.add_argument("--columns", **c)
     ft.set_defaults(func=_cmd_fit)
 
