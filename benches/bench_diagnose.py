@@ -1,7 +1,7 @@
 """Time a diagnosis of a 20,000-sample recording (one thread), and print the result.
 
 Run: ``OPENBLAS_NUM_THREADS=1 python benches/bench_diagnose.py [RECORDING MODEL]``
-(default: a 20 s concealed-cogging recording from :mod:`lugre.diagnose.synth`).
+(default: a 20 s concealed-cogging recording from :mod:`lugre.diagnosis.synth`).
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import lugre
-from lugre.diagnose import diagnose
-from lugre.diagnose.synth import concealed
+from lugre.diagnosis import diagnose
+from lugre.diagnosis.synth import concealed
 
 
 def main() -> None:

@@ -1,4 +1,4 @@
-"""Diagnosis on concealed-effect recordings (lugre.diagnose.synth) and on bad input."""
+"""Diagnosis on concealed-effect recordings (lugre.diagnosis.synth) and on bad input."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import warnings
 import lugre
 import numpy as np
 import pytest
-from lugre.diagnose import diagnose, evaluate, fit_inverse_dynamics, write_plots
-from lugre.diagnose.synth import concealed
+from lugre.diagnosis import diagnose, evaluate, fit_inverse_dynamics, write_plots
+from lugre.diagnosis.synth import concealed
 from lugre.exceptions import DataError, UnitsWarning
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import lugre
 import pytest
-from lugre.diagnose import diagnose, fit_inverse_dynamics
+from lugre.diagnosis import diagnose, fit_inverse_dynamics
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 MISMATCH = SHARED / "datasets" / "mismatch"

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from ._native import friction_force, simulate, simulate_batch, stribeck
 from ._result import SimResult
-from .diagnose import Diagnosis, diagnose, evaluate, fit_inverse_dynamics
+from .diagnosis import Diagnosis, diagnose, evaluate, fit_inverse_dynamics
 from .exceptions import (
     ConvergenceWarning,
     DataError,

@@ -105,7 +105,7 @@ def _jsonable(o: object) -> object:
 def _cmd_diagnose(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from .diagnose import diagnose, write_plots
+    from .diagnosis import diagnose, write_plots
     from .io import read_recording
     from .model import load_model, save_model
 
@@ -128,7 +128,7 @@ def _cmd_diagnose(args: argparse.Namespace) -> int:
 
 
 def _cmd_evaluate(args: argparse.Namespace) -> int:
-    from .diagnose import evaluate
+    from .diagnosis import evaluate
     from .io import read_recording
     from .model import load_model
 
@@ -141,7 +141,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 
 
 def _cmd_fit(args: argparse.Namespace) -> int:
-    from .diagnose import diagnose, evaluate, fit_inverse_dynamics
+    from .diagnosis import diagnose, evaluate, fit_inverse_dynamics
     from .io import read_recording
     from .model import save_model
 

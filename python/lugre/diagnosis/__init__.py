@@ -3,7 +3,7 @@
 show the fit improve.
 
 >>> import lugre
->>> from lugre.diagnose import diagnose, write_plots
+>>> from lugre.diagnosis import diagnose, write_plots
 >>> d = diagnose(lugre.read_recording("rec.csv"), lugre.load_model("m.json"))  # doctest: +SKIP
 >>> print(d.summary())                                                        # doctest: +SKIP
 """

@@ -23,7 +23,7 @@ def write_plots(diagnosis: Diagnosis, out_dir: str | os.PathLike[str]) -> list[P
     Parameters
     ----------
     diagnosis : Diagnosis
-        The result of :func:`lugre.diagnose.diagnose`.
+        The result of :func:`lugre.diagnosis.diagnose`.
     out_dir : str or os.PathLike
         Directory (created if needed).
 

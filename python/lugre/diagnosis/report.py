@@ -78,7 +78,7 @@ def _plain(o: Any) -> Any:
 
 @dataclass
 class Diagnosis:
-    """What :func:`lugre.diagnose.diagnose` found.
+    """What :func:`lugre.diagnosis.diagnose` found.
 
     Attributes
     ----------

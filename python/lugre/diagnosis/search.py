@@ -7,10 +7,10 @@ sample count nor a white-noise information criterion measures the evidence. Inst
   plus a set of effects) is fitted on ``K-1`` blocks and scored on the one left out;
 * squared errors are counted in units of ``sigma_eff**2 = noise**2 * n / n_eff``, the
   noise floor scaled by the effective number of independent samples of the filtered
-  noise (:func:`lugre.diagnose.residual.noise_floor`), so the score is a chi-square on
+  noise (:func:`lugre.diagnosis.residual.noise_floor`), so the score is a chi-square on
   the coloured scale;
 * the base LuGre parameters are re-estimated in every fit, under a Gaussian prior of
-  their tolerance (:data:`lugre.diagnose.effects.BASE_PARAMS`); the prior cost of how far
+  their tolerance (:data:`lugre.diagnosis.effects.BASE_PARAMS`); the prior cost of how far
   they must move is added to the score. A constant force that would otherwise need four
   Coulomb/static levels moved by ten per cent is then the cheaper story;
 * a term is accepted when it lowers the score by at least ``min_gain`` and its gain is
