@@ -465,6 +465,7 @@ def diagnose(
     q = J.shape[1]
     ev_sel = ev
     d, betas = _split(ev.beta, q, terms)
+    betas_sel = [b.copy() for b in betas]
     base = {n: E.get_base(model, n) for n, _ in E.BASE_PARAMS}
     for n, dv in zip(names, d):
         base[n] += dv
@@ -499,6 +500,29 @@ def diagnose(
             }]
     elif terms:
         aug, base, betas, ctx = _refine(model, sig, terms, base, betas, s2)
+        # a term accepted in the linearised selection whose share collapses in the joint
+        # refit (rms contribution under min_effect of the noise floor) is not a finding
+        small = []
+        for k, t in enumerate(terms):
+            c = np.einsum("ij,j->i", t.cand.columns(t.h, ctx), betas[k])[sig.mask]
+            if float(np.sqrt(np.mean(c * c))) < 0.2 * noise["rms"]:
+                small.append(k)
+        if small:
+            for k in small:
+                lg = next((g for g in log if g["accepted"] and g["effect"] == terms[k].effect),
+                          None)
+                if lg is not None:
+                    lg["accepted"] = False
+                    lg["why"] += ("; dropped: its contribution after the joint refit is "
+                                  "small against the noise floor")
+            keep = [k for k in range(len(terms)) if k not in small]
+            terms = [terms[k] for k in keep]
+            base = {n: E.get_base(model, n) for n, _ in E.BASE_PARAMS}
+            for n, dv in zip(names, d):
+                base[n] += dv
+            betas0 = [betas_sel[k] for k in keep]
+            aug, base, betas, ctx = _refine(model, sig, terms, base, betas0, s2,
+                                            iters=3 if terms else 2)
     else:
         aug, base, betas, ctx = _refine(model, sig, [], base, [], s2, iters=2)
 

@@ -68,7 +68,16 @@ def lowpass(y: np.ndarray, cutoff_hz: float, fs: float, order: int = 4) -> np.nd
 
 
 def hampel(y: np.ndarray, half_window: int = 5, k: float = 5.0) -> tuple[np.ndarray, np.ndarray]:
-    """Replace isolated spikes by the local median (Hampel identifier).
+    """Replace isolated one-sample spikes by the local median (Hampel identifier).
+
+    A sample is a spike when it deviates from the moving median by more than ``k``
+    robust standard deviations **and** stands out from both its neighbours, in the
+    direction of the deviation, by at least half of it. A step of the force and the
+    controller's transient after it (a force pulse injected into the loop, a reversal)
+    deviate from the median too but are not isolated: they are real forces that move
+    the axis, so they stay in the signal, where the parallel filter treats them like the
+    acceleration they cause. Removing them from the force alone would leave the
+    acceleration unbalanced.
 
     Parameters
     ----------
@@ -92,9 +101,14 @@ def hampel(y: np.ndarray, half_window: int = 5, k: float = 5.0) -> tuple[np.ndar
     ad = np.abs(dev)
     ad = ad[ad > 0]
     s = 1.4826 * float(np.median(ad)) if ad.size else 0.0
-    if not s > 0:
+    if not s > 0 or y.size < 3:
         return y.copy(), np.zeros(y.shape, dtype=bool)
-    spikes = np.abs(dev) > k * s
+    left = y - np.r_[y[0], y[:-1]]
+    right = y - np.r_[y[1:], y[-1]]
+    sd = np.sign(dev)
+    isolated = ((np.sign(left) == sd) & (np.sign(right) == sd)
+                & (np.minimum(np.abs(left), np.abs(right)) > 0.5 * np.abs(dev)))
+    spikes = (np.abs(dev) > k * s) & isolated
     out = y.copy()
     out[spikes] = med[spikes]
     return out, spikes
