@@ -281,6 +281,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (LugreError, FileNotFoundError, IsADirectoryError, PermissionError) as e:
         print(f"lugre {args.command}: error: {e}", file=sys.stderr)
         return 1
+    except BrokenPipeError:
+        # the reader of our output went away (e.g. `| head`): not an error of ours
+        sys.stdout = open(os.devnull, "w")  # noqa: SIM115
+        return 0
     except KeyboardInterrupt:
         print(f"lugre {args.command}: interrupted", file=sys.stderr)
         return 130
