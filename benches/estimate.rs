@@ -14,12 +14,6 @@ use lugre::friction::StaticSet;
 use lugre::servo::{simulate, Drive, Model, SimOptions};
 use std::time::Duration;
 
-const PAPER: &str = r#"{"axis": {"mass": 25, "force_constant": 25},
-  "friction": {"sigma0": 1e5, "sigma1": 31.62,
-    "positive": {"fc": 28.7, "fs": 60.2, "sigma2": 332.5, "vs": 0.01},
-    "negative": {"fc": 28.5, "fs": 60.1, "sigma2": 333.0, "vs": 0.01}},
-  "controller": {"type": "pid", "kp": 5e4, "ki": 5e5, "kd": 1500, "rate_hz": 10000}}"#;
-
 /// Deterministic noise in [-1, 1) (a linear congruential sequence).
 fn noise(n: usize) -> Vec<f64> {
     let mut s: u64 = 0x2545_f491_4f6c_dd1d;
@@ -67,7 +61,7 @@ fn static_fit(c: &mut Criterion) {
 
 /// A 1 s closed-loop record at 10 kHz (ramp out and back at 1 mm/s, 1 um encoder).
 fn dynamic_record() -> (Model, Vec<f64>, Vec<f64>, Vec<f64>) {
-    let m = Model::from_json(PAPER).unwrap();
+    let m = Model::paper();
     let t: Vec<f64> = (0..10_001).map(|k| k as f64 * 1e-4).collect();
     let xr: Vec<f64> = t
         .iter()

@@ -15,12 +15,6 @@ use lugre::servo::{simulate, simulate_batch, Drive, Model, SimOptions};
 use std::hint::black_box;
 use std::time::Duration;
 
-const PAPER: &str = r#"{"axis": {"mass": 25, "force_constant": 25},
-  "friction": {"sigma0": 1e5, "sigma1": 31.62,
-    "positive": {"fc": 28.7, "fs": 60.2, "sigma2": 332.5, "vs": 0.01},
-    "negative": {"fc": 28.5, "fs": 60.1, "sigma2": 333.0, "vs": 0.01}},
-  "controller": {"type": "pid", "kp": 5e4, "ki": 5e5, "kd": 1500, "rate_hz": 10000}}"#;
-
 const RATE: f64 = 1e4;
 
 /// Sample grid of `m` points over `steps` control periods and a sine reference
@@ -89,7 +83,7 @@ fn paper_params() -> LugreParams {
 /// One trajectory, 1e4 to 1e7 control periods (one plant step each), output
 /// decimated to 1001 samples; `full` records every step.
 fn closed_loop(c: &mut Criterion) {
-    let model = Model::from_json(PAPER).unwrap();
+    let model = Model::paper();
     let p = paper_params();
     let opts = SimOptions::default();
     let mut g = c.benchmark_group("closed_loop_step");
@@ -147,7 +141,7 @@ fn friction(c: &mut Criterion) {
 
 /// Eight models of one batch on 1 and on 2 worker threads.
 fn batch(c: &mut Criterion) {
-    let base = Model::from_json(PAPER).unwrap();
+    let base = Model::paper();
     let models: Vec<Model> = (0..8)
         .map(|k| {
             let mut m = base.clone();

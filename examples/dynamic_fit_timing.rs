@@ -5,14 +5,8 @@ use lugre::estimate::{fit_dynamic, DynamicFitOptions};
 use lugre::servo::{simulate, Drive, Model, SimOptions};
 use std::time::Instant;
 
-const PAPER: &str = r#"{"axis": {"mass": 25, "force_constant": 25},
-  "friction": {"sigma0": 1e5, "sigma1": 31.62,
-    "positive": {"fc": 28.7, "fs": 60.2, "sigma2": 332.5, "vs": 0.01},
-    "negative": {"fc": 28.5, "fs": 60.1, "sigma2": 333.0, "vs": 0.01}},
-  "controller": {"type": "pid", "kp": 5e4, "ki": 5e5, "kd": 1500, "rate_hz": 10000}}"#;
-
 fn main() {
-    let m = Model::from_json(PAPER).expect("model");
+    let m = Model::paper();
     let t: Vec<f64> = (0..40001).map(|k| k as f64 * 1e-4).collect();
     let xr: Vec<f64> = t
         .iter()

@@ -365,6 +365,47 @@ fn parse_effect(e: &Value, path: &str) -> Result<Effect> {
 }
 
 impl Model {
+    /// The seed paper's linear-motor axis (m = 25 kg, K_F = 25 N/A, LuGre parameters of
+    /// its Tables 1 and 2) under the CONTRACT's PID (kp 5e4, ki 5e5, kd 1500 at 10 kHz);
+    /// the twin of Python's `Model.paper()`.
+    ///
+    /// ```
+    /// let m = lugre::servo::Model::paper();
+    /// assert_eq!(m.friction.positive.fs, 60.2);
+    /// ```
+    pub fn paper() -> Model {
+        let set = |fc, fs, sigma2| StaticSet {
+            fc,
+            fs,
+            sigma2,
+            vs: 0.01,
+        };
+        Model {
+            axis: Axis {
+                mass: 25.0,
+                force_constant: 25.0,
+                current_loop: None,
+                current_limit: None,
+            },
+            friction: LugreParams {
+                sigma0: 1e5,
+                sigma1: 31.62,
+                positive: set(28.7, 60.2, 332.5),
+                negative: set(28.5, 60.1, 333.0),
+            },
+            effects: Vec::new(),
+            controller: Some(Controller {
+                law: ControlLaw::Pid {
+                    kp: 5e4,
+                    ki: 5e5,
+                    kd: 1500.0,
+                },
+                rate_hz: 1e4,
+                feedforward: None,
+            }),
+        }
+    }
+
     /// Parse and validate a model from its JSON text.
     pub fn from_json(text: &str) -> Result<Model> {
         let v: Value = serde_json::from_str(text)
@@ -569,6 +610,7 @@ mod tests {
     #[test]
     fn parses_contract_example() {
         let m = Model::from_json(PAPER).unwrap();
+        assert_eq!(m, Model::paper());
         assert_eq!(m.axis.mass, 25.0);
         assert_eq!(m.friction.negative.sigma2, 333.0);
         assert!(matches!(
