@@ -296,3 +296,128 @@ fn bad_input_is_an_error() {
     .unwrap_err();
     assert_eq!(e, Error::Interrupted);
 }
+
+fn sim(
+    m: &Model,
+    t: &[f64],
+    d: Drive,
+    integrator: Integrator,
+    substeps: usize,
+    v0: f64,
+) -> lugre::servo::SimResult {
+    let o = SimOptions {
+        integrator,
+        substeps,
+        v0,
+        ..SimOptions::default()
+    };
+    simulate(m, t, d, &o, &mut || true).unwrap()
+}
+
+fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+const RESONANCE: &str =
+    r#"{"effect": "resonance", "frequency": 40.0, "damping_ratio": 0.05, "load_fraction": 0.6}"#;
+
+/// Two-mass axis: halving the plant step shrinks the error at first order (exact
+/// splitting: semi-implicit Euler on both bodies) and fourth order (RK4), in open loop
+/// while both bodies slide forwards (smooth right-hand side).
+#[test]
+fn resonance_order_by_step_halving() {
+    let effects = format!(
+        r#"{RESONANCE}, {{"effect": "drag", "coefficient": 50.0}},
+           {{"effect": "stribeck_shape", "exponent": 1.3}}"#
+    );
+    let m = paper(&effects, "");
+    let t = grid(51, 2e-3);
+    let i = vec![3.0; t.len()];
+    let reference = sim(&m, &t, Drive::Current(&i), Integrator::Rk4, 512, 0.2);
+    assert!(reference.v.iter().all(|&v| v > 0.05), "keeps sliding");
+    let err = |integ, sub| {
+        let r = sim(&m, &t, Drive::Current(&i), integ, sub, 0.2);
+        max_abs_diff(&r.x, &reference.x)
+    };
+    let e: Vec<f64> = [4, 8, 16, 32]
+        .iter()
+        .map(|&s| err(Integrator::Exact, s))
+        .collect();
+    for w in e.windows(2) {
+        let r = w[0] / w[1];
+        assert!(
+            r > 1.7 && r < 2.3,
+            "exact ratio {r} (want ~2), errors {e:?}"
+        );
+    }
+    let e: Vec<f64> = [2, 4, 8].iter().map(|&s| err(Integrator::Rk4, s)).collect();
+    for w in e.windows(2) {
+        let r = w[0] / w[1];
+        assert!(
+            r > 12.0 && r < 20.0,
+            "rk4 ratio {r} (want ~16), errors {e:?}"
+        );
+    }
+}
+
+/// A mode too stiff for the plant step is refused, naming `substeps` and the fix.
+#[test]
+fn resonance_too_stiff_is_refused() {
+    let stiff = r#"{"effect": "resonance", "frequency": 1200.0, "damping_ratio": 0.05, "load_fraction": 0.75}"#;
+    let m = paper(stiff, PID);
+    let t = grid(101, 1e-4);
+    let xr = vec![0.0; t.len()];
+    let o = SimOptions::default();
+    let e = simulate(&m, &t, Drive::Position(&xr), &o, &mut || true).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        matches!(e, Error::Parameter { ref name, .. } if name == "substeps"),
+        "{msg}"
+    );
+    assert!(msg.contains("substeps >= 2"), "{msg}");
+    // the suggested number of substeps runs
+    let o = SimOptions { substeps: 2, ..o };
+    let r = simulate(&m, &t, Drive::Position(&xr), &o, &mut || true).unwrap();
+    assert!(r.x.iter().all(|x| x.is_finite()));
+}
+
+/// A command inside the dead band produces no force and no motion; beyond it the force
+/// is `K_F*(|i| - band)`.
+#[test]
+fn deadband_inside_and_outside() {
+    let m = paper(r#"{"effect": "deadband", "current": 0.5}"#, "");
+    let t = grid(201, 1e-3);
+    let inside: Vec<f64> = t
+        .iter()
+        .map(|&s| 0.45 * (2.0 * std::f64::consts::PI * 5.0 * s).sin())
+        .collect();
+    let r = sim(&m, &t, Drive::Current(&inside), Integrator::Exact, 1, 0.0);
+    assert!(r.x.iter().all(|&x| x == 0.0) && r.force.iter().all(|&f| f == 0.0));
+    assert_eq!(r.i, inside, "the recorded current is the command");
+    let outside = vec![-4.0; t.len()];
+    let r = sim(&m, &t, Drive::Current(&outside), Integrator::Exact, 1, 0.0);
+    assert!(r.force.iter().all(|&f| f == 25.0 * (-3.5)));
+    assert!(*r.x.last().unwrap() < -1e-3);
+}
+
+/// At constant speed the drag adds `c*v*|v|` to the Stribeck force the PID must supply.
+#[test]
+fn drag_steady_force() {
+    let c = 120.0;
+    let m = paper(&format!(r#"{{"effect": "drag", "coefficient": {c}}}"#), PID);
+    let t = grid(20_001, 1e-4);
+    for vr in [0.2, -0.3] {
+        let xr: Vec<f64> = t.iter().map(|&s| vr * s).collect();
+        let r = sim(&m, &t, Drive::Position(&xr), Integrator::Exact, 1, 0.0);
+        let n = t.len();
+        let f_motor = r.force[n - 2000..].iter().sum::<f64>() / 2000.0;
+        let want = m.friction.stribeck(vr) + c * vr * vr.abs();
+        assert!(
+            (f_motor - want).abs() < 1e-3 * want.abs(),
+            "v {vr}: motor force {f_motor} vs {want}"
+        );
+    }
+}

@@ -207,3 +207,201 @@ def test_core_rejects_bad_model_json_directly():
     with pytest.raises(lugre.ParameterError) as e:
         _core.stribeck(np.zeros(1), json.dumps(d))
     assert "axis.mass" in str(e.value) and e.value.name == "axis.mass"
+
+
+# ---- effects of issue 10: resonance, deadband, drag, stribeck_shape --------------------
+
+RESONANCE = {"effect": "resonance", "frequency": 22.0, "damping_ratio": 0.04,
+             "load_fraction": 0.75}
+NEW_EFFECTS = {
+    "resonance": [RESONANCE],
+    "deadband": [{"effect": "deadband", "current": 0.15}],
+    "drag": [{"effect": "drag", "coefficient": 120.0}],
+    "stribeck_shape": [{"effect": "stribeck_shape", "exponent": 0.8}],
+    "resonance+cogging+deadband": [
+        RESONANCE, EFFECTS["cogging"][0], {"effect": "deadband", "current": 0.3}],
+    "resonance+drag+shape+position_friction+lag": [
+        {**RESONANCE, "frequency": 150.0, "damping_ratio": 0.2},
+        {"effect": "drag", "coefficient": 80.0},
+        {"effect": "stribeck_shape", "exponent": 1.4},
+        EFFECTS["position_friction"][0], EFFECTS["current_lag"][0]],
+    "deadband+delay+drift+mass": [
+        {"effect": "deadband", "current": 0.2}, EFFECTS["delay"][0],
+        EFFECTS["drift"][0], EFFECTS["mass"][0]],
+}
+
+
+def max_diff(a, b):
+    return max(float(np.max(np.abs(getattr(a, f) - getattr(b, f)))) for f in
+               lugre.SimResult.fields)
+
+
+@pytest.mark.parametrize("name", sorted(NEW_EFFECTS))
+@pytest.mark.parametrize("integrator", ["exact", "rk4"])
+def test_new_effects_pid_twins_bit_identical(name, integrator):
+    m = paper(effects=NEW_EFFECTS[name])
+    t = np.arange(0, 0.4, 1e-4)
+    x_ref = 0.02 * np.sin(2 * np.pi * 1.5 * t)
+    a = lugre.simulate(m, t, x_ref, integrator=integrator)
+    b = ref.simulate(m, t, x_ref, integrator=integrator)
+    assert np.ptp(a.x) > 1e-3  # the axis moves
+    assert max_diff(a, b) == 0.0
+
+
+@pytest.mark.parametrize("name", sorted(NEW_EFFECTS))
+@pytest.mark.parametrize("integrator", ["exact", "rk4"])
+def test_new_effects_open_loop_twins_bit_identical(name, integrator):
+    m = paper(effects=NEW_EFFECTS[name])
+    t = np.arange(0, 0.3, 1e-3)
+    i = 3.0 * np.sin(2 * np.pi * 4 * t)
+    a = lugre.simulate(m, t, current=i, integrator=integrator, substeps=4)
+    b = ref.simulate(m, t, current=i, integrator=integrator, substeps=4)
+    assert np.ptp(a.x) > 1e-3
+    assert max_diff(a, b) == 0.0
+
+
+def test_new_effects_with_current_loop_and_feedforward_twins():
+    d = paper(effects=NEW_EFFECTS["resonance+cogging+deadband"]).to_dict()
+    d["axis"]["current_loop"] = {"resistance": 1.2, "inductance": 0.01874,
+                                 "back_emf": 25.0, "bandwidth_hz": 1000.0}
+    d["controller"]["feedforward"] = {"type": "lugre"}
+    m = lugre.Model.from_dict(d)
+    t = np.arange(0, 0.3, 3.3e-4)
+    x_ref = 0.01 * np.sin(2 * np.pi * 2 * t)
+    a = lugre.simulate(m, t, x_ref, substeps=2)
+    b = ref.simulate(m, t, x_ref, substeps=2)
+    assert max_diff(a, b) == 0.0
+
+
+@pytest.mark.parametrize("backend", BACKENDS, ids=["lugre", "reference"])
+def test_resonance_too_stiff_refused(backend):
+    m = paper(effects=[{**RESONANCE, "frequency": 1200.0}])
+    t = np.arange(0, 0.01, 1e-4)
+    with pytest.raises(lugre.ParameterError) as e:
+        backend.simulate(m, t, np.zeros_like(t))
+    assert e.value.name == "substeps" and "substeps >= 2" in str(e.value)
+    assert np.all(np.isfinite(backend.simulate(m, t, np.zeros_like(t), substeps=2).x))
+
+
+def test_resonance_refusal_messages_equal():
+    m = paper(effects=[{**RESONANCE, "frequency": 900.0, "damping_ratio": 0.3}])
+    t = np.arange(0, 0.01, 1e-4)
+    msgs = []
+    for b in BACKENDS:
+        with pytest.raises(lugre.ParameterError) as e:
+            b.simulate(m, t, np.zeros_like(t))
+        msgs.append(str(e.value))
+    assert msgs[0] == msgs[1]
+
+
+# ---- friction_force with stribeck_shape and scale ----------------------------------------
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    data=st.lists(st.tuples(st.floats(-0.5, 0.5), st.floats(0.2, 3.0)), min_size=1,
+                  max_size=300),
+    dt=st.floats(1e-6, 1e-2),
+    z0=st.floats(-5e-4, 5e-4),
+    exponent=st.one_of(st.none(), st.floats(0.3, 4.0)),
+    use_scale=st.booleans(),
+)
+def test_friction_force_scale_shape_twins(data, dt, z0, exponent, use_scale):
+    effects = [] if exponent is None else [{"effect": "stribeck_shape", "exponent": exponent}]
+    m = paper(effects=effects)
+    v = [a for a, _ in data]
+    scale = [s for _, s in data] if use_scale else None
+    fa, za = lugre.friction_force(v, dt, m, z0=z0, return_z=True, scale=scale)
+    fb, zb = ref.friction_force(v, dt, m, z0=z0, return_z=True, scale=scale)
+    np.testing.assert_array_equal(fa, fb)
+    np.testing.assert_array_equal(za, zb)
+
+
+def test_friction_force_scale_is_g_multiplier():
+    """Steady sliding: F -> s*g(v) + sigma2*v, with the shaped curve."""
+    m = paper(effects=[{"effect": "stribeck_shape", "exponent": 0.8}])
+    v = np.full(40000, 0.004)  # 27 time constants of z
+    for backend in BACKENDS:
+        f = backend.friction_force(v, 1e-4, m, scale=np.full(v.size, 1.3))
+        p = m.positive
+        g = p["fc"] + (p["fs"] - p["fc"]) * np.exp(-abs(0.004 / p["vs"]) ** 0.8)
+        assert f[-1] == pytest.approx(1.3 * g + p["sigma2"] * 0.004, rel=1e-9)
+    # scale of ones and no scale agree; per-sample dt works with a scale
+    a = lugre.friction_force(v, 1e-4, m)
+    b = lugre.friction_force(v, np.full(v.size, 1e-4), m, scale=np.ones(v.size))
+    np.testing.assert_array_equal(a, b)
+
+
+BAD_SCALE = [
+    ("scale length", {"scale": [1.0, 1.0]}, ["scale", "same length"]),
+    ("scale nan", {"scale": [1.0, math.nan, 1.0]}, ["scale", "element 1"]),
+    ("scale inf", {"scale": [1.0, 1.0, math.inf]}, ["scale", "element 2"]),
+    ("scale zero", {"scale": [1.0, 0.0, 1.0]}, ["scale", "element 1", "greater than zero"]),
+    ("scale 2-D", {"scale": [[1.0, 1.0, 1.0]]}, ["scale", "1-D"]),
+]
+
+
+@pytest.mark.parametrize("desc,kw,words", BAD_SCALE, ids=[b[0] for b in BAD_SCALE])
+def test_friction_force_bad_scale_same_errors(desc, kw, words):
+    msgs = []
+    for backend in BACKENDS:
+        with pytest.raises(lugre.InputError) as e:
+            backend.friction_force([0.1, 0.2, 0.3], 1e-3, lugre.Model.paper(), **kw)
+        for w in words:
+            assert w in str(e.value), (w, str(e.value))
+        msgs.append(str(e.value))
+    assert msgs[0] == msgs[1]
+
+
+# ---- validation of the new effects: the same errors from the core and from Python ---------
+
+BAD_EFFECTS = [
+    ("effects[0].frequency", lugre.ParameterError, [{**RESONANCE, "frequency": 0.0}]),
+    ("effects[0].damping_ratio", lugre.ParameterError, [{**RESONANCE, "damping_ratio": -0.1}]),
+    ("effects[0].load_fraction", lugre.ParameterError, [{**RESONANCE, "load_fraction": 1.0}]),
+    ("effects[0].load_fraction", lugre.ParameterError, [{**RESONANCE, "load_fraction": 0.0}]),
+    ("effects[0].load_fraction", lugre.ModelError,
+     [{k: v for k, v in RESONANCE.items() if k != "load_fraction"}]),
+    ("effects[1].current", lugre.ParameterError,
+     [{"effect": "drag", "coefficient": 1.0}, {"effect": "deadband", "current": -0.1}]),
+    ("effects[0].coefficient", lugre.ParameterError, [{"effect": "drag", "coefficient": -1}]),
+    ("effects[0].coefficient", lugre.ModelError, [{"effect": "drag", "coefficient": "big"}]),
+    ("effects[0].exponent", lugre.ParameterError, [{"effect": "stribeck_shape", "exponent": 0}]),
+    ("effects[0].exponent", lugre.ParameterError,
+     [{"effect": "stribeck_shape", "exponent": -1.5}]),
+    ("effects", lugre.ModelError, [RESONANCE, RESONANCE]),
+    ("effects", lugre.ModelError, [{"effect": "stribeck_shape", "exponent": 1.0},
+                                   {"effect": "stribeck_shape", "exponent": 2.0}]),
+    ("effects[0].effect", lugre.ModelError, [{"effect": "backlash"}]),
+]
+
+
+@pytest.mark.parametrize("path,cls,effects", BAD_EFFECTS,
+                         ids=[f"{p}-{k}" for k, (p, _, _) in enumerate(BAD_EFFECTS)])
+def test_new_effect_validation_same_errors(path, cls, effects):
+    import json
+
+    from lugre import _core
+
+    d = lugre.Model.paper().to_dict()
+    d["effects"] = effects
+    with pytest.raises(cls) as py_err:
+        lugre.Model.from_dict(d)
+    text = json.dumps(d)
+    with pytest.raises(cls) as core_err:
+        _core.check_model(text)
+    assert str(py_err.value) == str(core_err.value)
+    assert path in str(py_err.value)
+
+
+def test_new_effects_save_round_trip(tmp_path):
+    d = lugre.Model.paper().to_dict()
+    d["effects"] = NEW_EFFECTS["resonance+drag+shape+position_friction+lag"] + [
+        {"effect": "deadband", "current": 0.1, "note": "kept"}]
+    m = lugre.Model.from_dict(d)
+    lugre.save_model(m, tmp_path / "m.json")
+    back = lugre.load_model(tmp_path / "m.json")
+    assert back == m and back.effects[-1]["note"] == "kept"
+    t = np.arange(0, 0.05, 1e-4)
+    np.testing.assert_array_equal(lugre.simulate(back, t, 0.01 * t).x,
+                                  lugre.simulate(m, t, 0.01 * t).x)

@@ -28,6 +28,7 @@ def friction_force(
     model_json: str,
     z0: float = 0.0,
     return_z: bool = False,
+    scale: npt.NDArray[np.float64] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def simulate(
     model_json: str,

@@ -70,11 +70,13 @@ def friction_force(
     *,
     z0: float = 0.0,
     return_z: bool = False,
+    scale: Any = None,
 ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """LuGre friction force driven by a sampled velocity signal (see the reference).
 
     For ``k = 0 .. n-1``: ``F[k]`` is the force at state ``z`` and ``v[k]``; then ``z``
-    advances exactly over ``dt`` (or ``dt[k]``) with ``v[k]`` held.
+    advances exactly over ``dt`` (or ``dt[k]``) with ``v[k]`` held. The model's
+    ``stribeck_shape`` effect, if any, sets the exponent of ``g(v)``.
 
     Parameters
     ----------
@@ -88,6 +90,9 @@ def friction_force(
         Initial bristle deflection [m].
     return_z : bool, default False
         Also return ``z[k]``, the state at which ``F[k]`` was evaluated.
+    scale : array_like, optional
+        One positive factor per sample multiplying ``g(v[k])`` (position- or
+        time-dependent friction levels).
 
     Returns
     -------
@@ -97,11 +102,12 @@ def friction_force(
         Only with ``return_z``.
     """
     vv = _array("v", v)
+    sc = None if scale is None else _array("scale", scale)
     try:
         dta = np.ascontiguousarray(dt, dtype=np.float64).reshape(-1)
     except (TypeError, ValueError) as e:
         raise InputError.at("dt", f"must be a number or an array of numbers ({e})") from None
-    f, z = _core.friction_force(vv, dta, _json(model), _float("z0", z0), bool(return_z))
+    f, z = _core.friction_force(vv, dta, _json(model), _float("z0", z0), bool(return_z), sc)
     return (f, z) if return_z else f
 
 

@@ -37,7 +37,8 @@ __all__ = ["Model", "ModelLike", "load_model", "save_model"]
 
 _TWO_PI = 2.0 * math.pi
 _EFFECTS = (
-    "cogging, spring, offset, position_friction, drift, mass, delay, current_lag"
+    "cogging, spring, offset, position_friction, drift, mass, delay, current_lag, "
+    "resonance, deadband, drag, stribeck_shape"
 )
 _MISSING = "is missing: add it (see docs/DESIGN.md for the model format)"
 
@@ -125,6 +126,14 @@ class _Parsed:
     def total_mass(self) -> float:
         dm = sum(e.params["delta"] for e in self.effects if e.kind == "mass")
         return self.axis.mass + dm
+
+    @property
+    def stribeck_exponent(self) -> float | None:
+        """Exponent of a ``stribeck_shape`` effect, ``None`` without one."""
+        for e in self.effects:
+            if e.kind == "stribeck_shape":
+                return float(e.params["exponent"])
+        return None
 
 
 # --------------------------------------------------------------------------------------
@@ -316,6 +325,23 @@ def _parse_effect(e: Any, path: str) -> _Effect:
         return _Effect(kind, {"seconds": _nonneg(n("seconds"), p("seconds"))})
     if kind == "current_lag":
         return _Effect(kind, {"bandwidth_hz": _positive(n("bandwidth"), p("bandwidth"))})
+    if kind == "resonance":
+        frequency = _positive(n("frequency"), p("frequency"))
+        zeta = _nonneg(n("damping_ratio"), p("damping_ratio"))
+        r = n("load_fraction")
+        if not (0.0 < r < 1.0):
+            raise ParameterError.invalid(
+                p("load_fraction"), r,
+                "must lie strictly between 0 and 1 (the load's share of the total mass)",
+            )
+        return _Effect(kind, {"frequency_hz": frequency, "damping_ratio": zeta,
+                              "load_fraction": r})
+    if kind == "deadband":
+        return _Effect(kind, {"current": _nonneg(n("current"), p("current"))})
+    if kind == "drag":
+        return _Effect(kind, {"coefficient": _nonneg(n("coefficient"), p("coefficient"))})
+    if kind == "stribeck_shape":
+        return _Effect(kind, {"exponent": _positive(n("exponent"), p("exponent"))})
     raise ModelError.at(p("effect"), f'unknown effect "{kind}": use one of {_EFFECTS}')
 
 
@@ -405,6 +431,12 @@ def _parse(v: Mapping[str, Any]) -> _Parsed:
     if n_delay > 1 or n_lag > 1:
         raise ModelError.at(
             "effects", "holds more than one delay or current_lag: merge them into one"
+        )
+    n_res = sum(e.kind == "resonance" for e in effects)
+    n_shape = sum(e.kind == "stribeck_shape" for e in effects)
+    if n_res > 1 or n_shape > 1:
+        raise ModelError.at(
+            "effects", "holds more than one resonance or stribeck_shape: keep one of each"
         )
     dm = sum(e.params["delta"] for e in effects if e.kind == "mass")
     if mass + dm <= 0.0:

@@ -126,6 +126,12 @@ def _g(s: _StaticSet, v: float) -> float:
     return s.fc + (s.fs - s.fc) * _exp(-(r * r))
 
 
+def _g_shaped(s: _StaticSet, v: float, exponent: float) -> float:
+    """``g(v) = fc + (fs - fc)*exp(-|v/vs|^exponent)`` (``StaticSet::g_shaped``)."""
+    r = abs(v / s.vs)
+    return s.fc + (s.fs - s.fc) * _exp(-(r**exponent))
+
+
 def _stribeck1(p: _Friction, v: float) -> float:
     """Steady-state friction ``sign(v)*g(v) + sigma2*v``, zero at ``v == 0``."""
     if v == 0.0:
@@ -138,6 +144,17 @@ def _eval(p: _Friction, z: float, v: float, scale: float) -> tuple[float, float,
     """``(g, F, zdot)`` at state ``z`` and velocity ``v`` (``LugreParams::eval``)."""
     s = p.positive if v >= 0.0 else p.negative
     g = scale * _g(s, v)
+    zdot = v - p.sigma0 * abs(v) * z / g
+    f = p.sigma0 * z + p.sigma1 * zdot + s.sigma2 * v
+    return g, f, zdot
+
+
+def _eval_shaped(
+    p: _Friction, z: float, v: float, scale: float, exponent: float
+) -> tuple[float, float, float]:
+    """As :func:`_eval` with the generalised curve (``LugreParams::eval_shaped``)."""
+    s = p.positive if v >= 0.0 else p.negative
+    g = scale * _g_shaped(s, v, exponent)
     zdot = v - p.sigma0 * abs(v) * z / g
     f = p.sigma0 * z + p.sigma1 * zdot + s.sigma2 * v
     return g, f, zdot
@@ -202,11 +219,13 @@ def friction_force(
     *,
     z0: float = 0.0,
     return_z: bool = False,
+    scale: Any = None,
 ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """LuGre friction force driven by a sampled velocity signal.
 
     For ``k = 0 .. n-1``: ``F[k]`` is the force at state ``z`` and ``v[k]``; then ``z``
-    advances exactly over ``dt`` (or ``dt[k]``) with ``v[k]`` held.
+    advances exactly over ``dt`` (or ``dt[k]``) with ``v[k]`` held. The model's
+    ``stribeck_shape`` effect, if any, sets the exponent of ``g(v)``.
 
     Parameters
     ----------
@@ -220,6 +239,9 @@ def friction_force(
         Initial bristle deflection [m].
     return_z : bool, default False
         Also return ``z[k]``, the state at which ``F[k]`` was evaluated.
+    scale : array_like, optional
+        One positive factor per sample multiplying ``g(v[k])`` (position- or
+        time-dependent friction levels).
 
     Returns
     -------
@@ -231,12 +253,16 @@ def friction_force(
     Raises
     ------
     InputError
-        ``v`` or ``dt`` not finite, ``dt`` negative or of the wrong length.
+        ``v`` or ``dt`` not finite, ``dt`` negative or of the wrong length; ``scale``
+        of the wrong length, not finite or not positive.
     ParameterError
         ``z0`` not finite.
     """
-    p = _as_model(model)._parsed.friction
+    parsed = _as_model(model)._parsed
+    p = parsed.friction
+    exponent = parsed.stribeck_exponent
     vv = _array("v", v).tolist()
+    sc = None if scale is None else _array("scale", scale).tolist()
     _check_finite("v", vv)
     try:
         dta = np.asarray(dt, dtype=float).reshape(-1)
@@ -257,12 +283,26 @@ def friction_force(
             )
     z = _finite_option("z0", z0)
     n = len(vv)
+    if sc is not None:
+        _check_len("scale", sc, n, "v")
+        _check_finite("scale", sc)
+        for k, x in enumerate(sc):
+            if x <= 0.0:
+                raise InputError.at(
+                    "scale",
+                    f"element {k} is {_fmt_f64(x)}: the friction scale must be greater "
+                    "than zero",
+                )
     out = [0.0] * n
     zs = [0.0] * n
     h = dts[0]
     for k in range(n):
         vk = vv[k]
-        g, f, _ = _eval(p, z, vk, 1.0)
+        s = 1.0 if sc is None else sc[k]
+        if exponent is None:
+            g, f, _ = _eval(p, z, vk, s)
+        else:
+            g, f, _ = _eval_shaped(p, z, vk, s, exponent)
         out[k] = f
         zs[k] = z
         z = _advance_z(p, z, vk, g, h if scalar else dts[k])
@@ -311,11 +351,30 @@ def _interp_clamped(xp: tuple[float, ...], fp: tuple[float, ...], x: float) -> f
 
 
 class _State:
-    __slots__ = ("fl", "ia", "q", "v", "x", "z")
+    __slots__ = ("fl", "ia", "q", "v", "vl", "x", "xl", "z")
 
     def __init__(self, x: float, v: float, z: float) -> None:
         self.x, self.v, self.z = x, v, z
         self.ia = self.q = self.fl = 0.0
+        self.xl, self.vl = x, v  # load (resonance)
+
+
+class _TwoMass:
+    """The two bodies of the ``resonance`` effect (``TwoMass`` in sim.rs)."""
+
+    def __init__(self, mass: float, frequency_hz: float, damping_ratio: float,
+                 r: float) -> None:
+        self.mm = (1.0 - r) * mass
+        self.ml = r * mass
+        w = 2.0 * _PI * frequency_hz
+        self.k = self.ml * (w * w)
+        self.c = 2.0 * damping_ratio * math.sqrt(self.k * self.ml)
+
+    def free_mode(self) -> tuple[float, float]:
+        """Angular frequency and damping ratio of the relative motor-load motion."""
+        mu = self.mm * self.ml / (self.mm + self.ml)
+        w = math.sqrt(self.k / mu)
+        return w, self.c / (2.0 * mu * w)
 
 
 class _Physics:
@@ -334,6 +393,10 @@ class _Physics:
         self.lag_w: float | None = None
         self.delay: float | None = None
         self.t0 = t0
+        self.shape: float | None = None
+        self.drag = 0.0
+        self.deadband: float | None = None
+        self.res: _TwoMass | None = None
         for e in m.effects:
             q = e.params
             if e.kind == "cogging":
@@ -354,6 +417,15 @@ class _Physics:
                 self.delay = q["seconds"]
             elif e.kind == "current_lag":
                 self.lag_w = 2.0 * _PI * q["bandwidth_hz"]
+            elif e.kind == "resonance":
+                self.res = _TwoMass(self.mass, q["frequency_hz"], q["damping_ratio"],
+                                    q["load_fraction"])
+            elif e.kind == "deadband":
+                self.deadband = q["current"]
+            elif e.kind == "drag":
+                self.drag += q["coefficient"]
+            elif e.kind == "stribeck_shape":
+                self.shape = q["exponent"]
         self.has_scale = bool(self.pos_scale) or bool(self.drift)
 
     def scale(self, x: float, time: float) -> float:
@@ -366,18 +438,41 @@ class _Physics:
             s *= 1.0 - gain * (1.0 - _exp(-(time - self.t0) / tau))
         return s
 
-    def effect_force(self, x: float) -> float:
+    def load(self, s: _State) -> tuple[float, float]:
+        """Position and velocity of the body carrying friction and effects."""
+        return (s.xl, s.vl) if self.res is not None else (s.x, s.v)
+
+    def friction(self, z: float, v: float, scale: float) -> tuple[float, float, float]:
+        """``(g, F, zdot)`` of the plant's friction (``stribeck_shape`` applied)."""
+        if self.shape is not None:
+            return _eval_shaped(self.fr, z, v, scale, self.shape)
+        return _eval(self.fr, z, v, scale)
+
+    def deadband_of(self, i: float) -> float:
+        """The current that produces force (``deadband``)."""
+        c = self.deadband
+        if c is None:
+            return i
+        if i > c:
+            return i - c
+        if i < -c:
+            return i + c
+        return 0.0
+
+    def effect_force(self, x: float, v: float) -> float:
         f = self.lin_a * x + self.lin_b
         for a, w, ph in self.cogging:
             f += a * math.sin(w * x + ph)
+        if self.drag != 0.0:
+            f += self.drag * abs(v) * v
         return f
 
     def accel(
         self, fm: float, x: float, v: float, z: float, time: float
     ) -> tuple[float, float, float]:
         s = self.scale(x, time)
-        g, f, zdot = _eval(self.fr, z, v, s)
-        return (fm - f - self.effect_force(x)) / self.mass, g, zdot
+        g, f, zdot = self.friction(z, v, s)
+        return (fm - f - self.effect_force(x, v)) / self.mass, g, zdot
 
     def motor(self, s: _State, ic: float, h: float) -> float:
         """Advance the current (loop) and the lagged force over ``h``; the motor force."""
@@ -403,7 +498,7 @@ class _Physics:
                 a4, b4 = d(s.ia + hs * a3, s.q + hs * b3)
                 s.ia += hs / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
                 s.q += hs / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4)
-        fm = self.kf * s.ia
+        fm = self.kf * self.deadband_of(s.ia)
         if self.lag_w is None:
             return fm
         s.fl = fm + (s.fl - fm) * _exp(-self.lag_w * h)
@@ -411,13 +506,53 @@ class _Physics:
 
     def step_exact(self, s: _State, ic: float, h: float, time: float) -> None:
         fm = self.motor(s, ic, h)
+        r = self.res
+        if r is not None:
+            # two bodies: semi-implicit Euler for both, exact bristle update on the load
+            g, f, _ = self.friction(s.z, s.vl, self.scale(s.xl, time))
+            fc = r.k * (s.x - s.xl) + r.c * (s.v - s.vl)
+            am = (fm - fc) / r.mm
+            al = (fc - f - self.effect_force(s.xl, s.vl)) / r.ml
+            s.z = _advance_z(self.fr, s.z, s.vl, g, h)
+            s.v += am * h
+            s.vl += al * h
+            s.x += s.v * h
+            s.xl += s.vl * h
+            return
         a, g, _ = self.accel(fm, s.x, s.v, s.z, time)
         s.z = _advance_z(self.fr, s.z, s.v, g, h)
         s.v += a * h
         s.x += s.v * h
 
+    def step_rk4_two_mass(self, s: _State, fm: float, r: _TwoMass, h: float,
+                          time: float) -> None:
+        """RK4 on ``(x, v, xl, vl, z)`` of the two-mass axis, the motor force held."""
+
+        def d(x: float, v: float, xl: float, vl: float, z: float,
+              tm: float) -> tuple[float, float, float, float, float]:
+            _, f, zdot = self.friction(z, vl, self.scale(xl, tm))
+            fc = r.k * (x - xl) + r.c * (v - vl)
+            return v, (fm - fc) / r.mm, vl, (fc - f - self.effect_force(xl, vl)) / r.ml, zdot
+
+        x, v, xl, vl, z = s.x, s.v, s.xl, s.vl, s.z
+        k1 = d(x, v, xl, vl, z, time)
+        k2 = d(x + 0.5 * h * k1[0], v + 0.5 * h * k1[1], xl + 0.5 * h * k1[2],
+               vl + 0.5 * h * k1[3], z + 0.5 * h * k1[4], time + 0.5 * h)
+        k3 = d(x + 0.5 * h * k2[0], v + 0.5 * h * k2[1], xl + 0.5 * h * k2[2],
+               vl + 0.5 * h * k2[3], z + 0.5 * h * k2[4], time + 0.5 * h)
+        k4 = d(x + h * k3[0], v + h * k3[1], xl + h * k3[2], vl + h * k3[3], z + h * k3[4],
+               time + h)
+        s.x += h / 6.0 * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0])
+        s.v += h / 6.0 * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1])
+        s.xl += h / 6.0 * (k1[2] + 2.0 * k2[2] + 2.0 * k3[2] + k4[2])
+        s.vl += h / 6.0 * (k1[3] + 2.0 * k2[3] + 2.0 * k3[3] + k4[3])
+        s.z += h / 6.0 * (k1[4] + 2.0 * k2[4] + 2.0 * k3[4] + k4[4])
+
     def step_rk4(self, s: _State, ic: float, h: float, time: float) -> None:
         fm = self.motor(s, ic, h)
+        if self.res is not None:
+            self.step_rk4_two_mass(s, fm, self.res, h, time)
+            return
 
         def d(x: float, v: float, z: float, tm: float) -> tuple[float, float, float]:
             a, _, zdot = self.accel(fm, x, v, z, tm)
@@ -549,6 +684,29 @@ def simulate(
                 "x_ref", "the model's controller is a PI speed loop: give v_ref instead"
             )
 
+    # ---- check_resonance_step -------------------------------------------------------
+    for e in m.effects:
+        if e.kind == "resonance":
+            q = e.params
+            tm = _TwoMass(m.total_mass, q["frequency_hz"], q["damping_ratio"],
+                          q["load_fraction"])
+            w, zeta = tm.free_mode()
+            limit = math.sqrt(1.0 + zeta * zeta) - zeta
+            if not open_loop:
+                assert m.controller is not None
+                hh = 1.0 / (m.controller.rate_hz * substeps)
+            else:
+                hh = (tl[-1] - tl[0]) / (len(tl) - 1) / substeps
+            if w * hh > limit:
+                need = math.ceil(substeps * w * hh / limit)
+                raise ParameterError.invalid(
+                    "substeps", float(substeps),
+                    "is too few for the resonance effect: its free motor-load mode at "
+                    f"{w / (2.0 * _PI):.1f} Hz needs plant steps below "
+                    f"{limit / (2.0 * _PI):.3f} of its period; use substeps >= {need} "
+                    "(or a higher control rate)",
+                )
+
     # ---- simulate -------------------------------------------------------------------
     n_out = len(tl)
     t0 = tl[0]
@@ -630,19 +788,20 @@ def simulate(
             n += 1
             tc = ctrl_time(n)
         while k < n_out and tl[k] <= time + tol:
-            sc = phys.scale(s.x, time)
-            _, f, _ = _eval(phys.fr, s.z, s.v, sc)
+            xl, vl = phys.load(s)
+            sc = phys.scale(xl, time)
+            _, f, _ = phys.friction(s.z, vl, sc)
             out_x.append(s.x)
             out_v.append(s.v)
             out_z.append(s.z)
             out_i.append(s.ia if phys.current_loop is not None else ic)
             out_f.append(f)
             if phys.current_loop is not None:
-                fm = phys.kf * s.ia
+                fm = phys.kf * phys.deadband_of(s.ia)
             elif phys.delay is not None:
-                fm = phys.kf * _ic_eff_peek(queue, ic_eff, time, tol)
+                fm = phys.kf * phys.deadband_of(_ic_eff_peek(queue, ic_eff, time, tol))
             else:
-                fm = phys.kf * ic_eff
+                fm = phys.kf * phys.deadband_of(ic_eff)
             out_fm.append(s.fl if phys.lag_w is not None else fm)
             k += 1
         if k == n_out:
@@ -656,7 +815,8 @@ def simulate(
                 while queue and queue[0][0] <= tj + tol:
                     ic_eff = queue.popleft()[1]
             step(s, ic_eff, h, tj)
-        if not (math.isfinite(s.x) and math.isfinite(s.v) and math.isfinite(s.z)):
+        if not (math.isfinite(s.x) and math.isfinite(s.v) and math.isfinite(s.z)
+                and math.isfinite(s.xl) and math.isfinite(s.vl)):
             raise DataError(
                 f"data: the simulation diverged at t = {_fmt_f64(time)}: check the controller gains "
                 "against the mass and the control rate"

@@ -137,6 +137,21 @@ impl<T: Float> StaticSet<T> {
         self.fc + (self.fs - self.fc) * (-(r * r)).exp()
     }
 
+    /// Generalised Stribeck curve `g(v) = fc + (fs - fc)*exp(-|v/vs|^exponent)` [N]
+    /// (the `stribeck_shape` effect). [`StaticSet::g`] is the case `exponent == 2`,
+    /// kept apart so that the usual curve needs no `powf`.
+    ///
+    /// ```
+    /// use lugre::friction::StaticSet;
+    /// let s = StaticSet::<f64>::new(28.7, 60.2, 332.5, 0.01).unwrap();
+    /// assert!((s.g_shaped(0.02, 2.0) - s.g(0.02)).abs() < 1e-12);
+    /// ```
+    #[inline(always)]
+    pub fn g_shaped(&self, v: T, exponent: T) -> T {
+        let r = (v / self.vs).abs();
+        self.fc + (self.fs - self.fc) * (-(r.powf(exponent))).exp()
+    }
+
     /// Steady-state friction `sign(v)*g(v) + sigma2*v`, zero at `v == 0`.
     #[inline]
     pub fn stribeck(&self, v: T) -> T {
@@ -248,6 +263,16 @@ impl<T: Float> LugreParams<T> {
         (g, f, zdot)
     }
 
+    /// As [`LugreParams::eval`] with the generalised curve [`StaticSet::g_shaped`].
+    #[inline(always)]
+    pub fn eval_shaped(&self, z: T, v: T, scale: T, exponent: T) -> (T, T, T) {
+        let s = self.set(v);
+        let g = scale * s.g_shaped(v, exponent);
+        let zdot = v - self.sigma0 * v.abs() * z / g;
+        let f = self.sigma0 * z + self.sigma1 * zdot + s.sigma2 * v;
+        (g, f, zdot)
+    }
+
     /// Exact bristle update over `h` with `v` held, given `g = g(v)`.
     #[inline(always)]
     pub fn advance_z(&self, z: T, v: T, g: T, h: T) -> T {
@@ -302,6 +327,43 @@ pub fn friction_force_varstep_into<T: Float>(
             zo[k] = z;
         }
         z = p.advance_z(z, vk, g, h);
+    }
+    z
+}
+
+/// As [`friction_force_into`] and [`friction_force_varstep_into`] with the options of
+/// the diagnosis: `dt` holds one interval for every sample or one per sample; `scale`,
+/// when given (one value per sample), multiplies `g(v[k])` at sample `k`; `exponent`,
+/// when given, replaces the Stribeck exponent 2 ([`StaticSet::g_shaped`]).
+///
+/// Lengths must match (checked by the caller). Returns the final `z`.
+#[allow(clippy::too_many_arguments)]
+pub fn friction_force_general_into<T: Float>(
+    p: &LugreParams<T>,
+    v: &[T],
+    dt: &[T],
+    z0: T,
+    scale: Option<&[T]>,
+    exponent: Option<T>,
+    out: &mut [T],
+    mut z_out: Option<&mut [T]>,
+) -> T {
+    let mut z = z0;
+    let one_dt = dt.len() == 1;
+    for (k, (&vk, o)) in v.iter().zip(out.iter_mut()).enumerate() {
+        let s = match scale {
+            Some(sc) => sc[k],
+            None => T::one(),
+        };
+        let (g, f, _) = match exponent {
+            Some(e) => p.eval_shaped(z, vk, s, e),
+            None => p.eval(z, vk, s),
+        };
+        *o = f;
+        if let Some(zo) = z_out.as_deref_mut() {
+            zo[k] = z;
+        }
+        z = p.advance_z(z, vk, g, if one_dt { dt[0] } else { dt[k] });
     }
     z
 }

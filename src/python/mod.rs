@@ -2,7 +2,9 @@
 //! released, convert out. No numerics here.
 
 use crate::error::{check_finite, Error};
-use crate::friction::{friction_force_into, friction_force_varstep_into};
+use crate::friction::{
+    friction_force_general_into, friction_force_into, friction_force_varstep_into,
+};
 use crate::servo::{self, Drive, Integrator, Model, SimOptions, SimResult};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
@@ -107,8 +109,10 @@ fn stribeck<'py>(
 }
 
 /// LuGre force driven by a sampled velocity; returns `(F, z)` (z empty unless asked).
+///
+/// The model's `stribeck_shape` applies; `scale` (one per sample) multiplies `g(v)`.
 #[pyfunction]
-#[pyo3(signature = (v, dt, model_json, z0=0.0, return_z=false))]
+#[pyo3(signature = (v, dt, model_json, z0=0.0, return_z=false, scale=None))]
 fn friction_force<'py>(
     py: Python<'py>,
     v: PyReadonlyArray1<'py, f64>,
@@ -116,11 +120,17 @@ fn friction_force<'py>(
     model_json: &str,
     z0: f64,
     return_z: bool,
+    scale: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<ArrayPair<'py>> {
     let m = parse_model(py, model_json)?;
     let p = m.friction;
+    let exponent = m.stribeck_exponent();
     let vs = slice("v", &v).map_err(|e| to_py(py, e))?;
     let dts = slice("dt", &dt).map_err(|e| to_py(py, e))?;
+    let sc = match &scale {
+        None => None,
+        Some(a) => Some(slice("scale", a).map_err(|e| to_py(py, e))?),
+    };
     (|| -> Result<(), Error> {
         check_finite("v", vs)?;
         if dts.is_empty() {
@@ -139,6 +149,9 @@ fn friction_force<'py>(
         if !z0.is_finite() {
             return Err(Error::parameter("z0", z0, "must be finite"));
         }
+        if let Some(sc) = sc {
+            check_scale(sc, vs.len())?;
+        }
         Ok(())
     })()
     .map_err(|e| to_py(py, e))?;
@@ -150,7 +163,9 @@ fn friction_force<'py>(
             Vec::new()
         };
         let zo = if return_z { Some(&mut z[..]) } else { None };
-        if dts.len() == 1 {
+        if sc.is_some() || exponent.is_some() {
+            friction_force_general_into(&p, vs, dts, z0, sc, exponent, &mut f, zo);
+        } else if dts.len() == 1 {
             friction_force_into(&p, vs, dts[0], z0, &mut f, zo);
         } else {
             friction_force_varstep_into(&p, vs, dts, z0, &mut f, zo);
@@ -158,6 +173,22 @@ fn friction_force<'py>(
         (f, z)
     });
     Ok((f.into_pyarray(py), z.into_pyarray(py)))
+}
+
+/// `scale` of `friction_force`: one positive finite factor per sample.
+fn check_scale(sc: &[f64], n: usize) -> Result<(), Error> {
+    crate::error::check_len("scale", sc, n, "v")?;
+    check_finite("scale", sc)?;
+    if let Some(k) = sc.iter().position(|&s| s <= 0.0) {
+        return Err(Error::input(
+            "scale",
+            format!(
+                "element {k} is {}: the friction scale must be greater than zero",
+                sc[k]
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn parse_opts(

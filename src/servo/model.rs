@@ -97,6 +97,32 @@ pub enum Effect {
         /// Bandwidth [Hz].
         bandwidth_hz: f64,
     },
+    /// Two masses joined by a spring-damper: the motor `(1 - r)*mass` (driven, measured)
+    /// and the load `r*mass` (friction and the other effects' forces act on it), with
+    /// `k = r*mass*(2*pi*frequency)^2` and `c = 2*damping_ratio*sqrt(k*r*mass)`.
+    Resonance {
+        /// Natural frequency of the load with the motor held [Hz].
+        frequency_hz: f64,
+        /// Damping ratio of that mode [-].
+        damping_ratio: f64,
+        /// Share `r` of the total mass on the load side, `0 < r < 1`.
+        load_fraction: f64,
+    },
+    /// Motor force `K_F*sign(i)*max(|i| - current, 0)`.
+    Deadband {
+        /// Half-width of the dead band [A].
+        current: f64,
+    },
+    /// Force `coefficient*|v|*v` opposing motion.
+    Drag {
+        /// [N s^2/m^2]
+        coefficient: f64,
+    },
+    /// `g(v) = fc + (fs - fc)*exp(-|v/vs|^exponent)` in place of exponent 2.
+    StribeckShape {
+        /// Exponent of the Stribeck curve [-].
+        exponent: f64,
+    },
 }
 
 /// Feed-forward law.
@@ -265,6 +291,10 @@ pub fn parse_friction(f: &Value, path: &str) -> Result<LugreParams<f64>> {
     Ok(p)
 }
 
+/// The effect vocabulary, for error messages.
+const EFFECT_NAMES: &str = "cogging, spring, offset, position_friction, drift, mass, delay, \
+                            current_lag, resonance, deadband, drag, stribeck_shape";
+
 fn parse_effect(e: &Value, path: &str) -> Result<Effect> {
     let kind = get(e, "effect", path)?
         .as_str()
@@ -352,13 +382,36 @@ fn parse_effect(e: &Value, path: &str) -> Result<Effect> {
         "current_lag" => Effect::CurrentLag {
             bandwidth_hz: positive(n("bandwidth")?, &p("bandwidth"))?,
         },
+        "resonance" => {
+            let frequency_hz = positive(n("frequency")?, &p("frequency"))?;
+            let damping_ratio = nonneg(n("damping_ratio")?, &p("damping_ratio"))?;
+            let load_fraction = n("load_fraction")?;
+            if !(load_fraction > 0.0 && load_fraction < 1.0) {
+                return Err(Error::parameter(
+                    &p("load_fraction"),
+                    load_fraction,
+                    "must lie strictly between 0 and 1 (the load's share of the total mass)",
+                ));
+            }
+            Effect::Resonance {
+                frequency_hz,
+                damping_ratio,
+                load_fraction,
+            }
+        }
+        "deadband" => Effect::Deadband {
+            current: nonneg(n("current")?, &p("current"))?,
+        },
+        "drag" => Effect::Drag {
+            coefficient: nonneg(n("coefficient")?, &p("coefficient"))?,
+        },
+        "stribeck_shape" => Effect::StribeckShape {
+            exponent: positive(n("exponent")?, &p("exponent"))?,
+        },
         other => {
             return Err(Error::model(
                 &join(path, "effect"),
-                format!(
-                    "unknown effect \"{other}\": use one of cogging, spring, offset, \
-                     position_friction, drift, mass, delay, current_lag"
-                ),
+                format!("unknown effect \"{other}\": use one of {EFFECT_NAMES}"),
             ))
         }
     })
@@ -491,6 +544,20 @@ impl Model {
                 "holds more than one delay or current_lag: merge them into one",
             ));
         }
+        let n_res = effects
+            .iter()
+            .filter(|e| matches!(e, Effect::Resonance { .. }))
+            .count();
+        let n_shape = effects
+            .iter()
+            .filter(|e| matches!(e, Effect::StribeckShape { .. }))
+            .count();
+        if n_res > 1 || n_shape > 1 {
+            return Err(Error::model(
+                "effects",
+                "holds more than one resonance or stribeck_shape: keep one of each",
+            ));
+        }
         let dm: f64 = effects
             .iter()
             .map(|e| {
@@ -517,6 +584,14 @@ impl Model {
             friction,
             effects,
             controller,
+        })
+    }
+
+    /// Exponent of the plant's Stribeck curve when a `stribeck_shape` effect sets one.
+    pub fn stribeck_exponent(&self) -> Option<f64> {
+        self.effects.iter().find_map(|e| match e {
+            Effect::StribeckShape { exponent } => Some(*exponent),
+            _ => None,
         })
     }
 

@@ -141,6 +141,46 @@ struct Physics<const EXTRAS: bool> {
     lag_w: Option<f64>,
     delay: Option<f64>,
     t0: f64,
+    /// `stribeck_shape` exponent.
+    shape: Option<f64>,
+    /// `drag` coefficient (0 without drag).
+    drag: f64,
+    /// `deadband` half-width [A].
+    deadband: Option<f64>,
+    /// Two-mass `resonance`.
+    res: Option<TwoMass>,
+}
+
+/// The two bodies of the `resonance` effect and their coupling.
+#[derive(Debug, Clone, Copy)]
+struct TwoMass {
+    /// Coupling stiffness [N/m].
+    k: f64,
+    /// Coupling damping [N s/m].
+    c: f64,
+    /// Motor-side mass `(1 - r)*M` [kg].
+    mm: f64,
+    /// Load-side mass `r*M` [kg].
+    ml: f64,
+}
+
+impl TwoMass {
+    fn new(mass: f64, frequency_hz: f64, damping_ratio: f64, r: f64) -> Self {
+        let mm = (1.0 - r) * mass;
+        let ml = r * mass;
+        let w = 2.0 * PI * frequency_hz;
+        let k = ml * (w * w);
+        let c = 2.0 * damping_ratio * (k * ml).sqrt();
+        TwoMass { k, c, mm, ml }
+    }
+
+    /// Angular frequency [rad/s] and damping ratio of the free motor-load mode (the
+    /// relative motion, reduced mass `mm*ml/(mm + ml)`).
+    fn free_mode(&self) -> (f64, f64) {
+        let mu = self.mm * self.ml / (self.mm + self.ml);
+        let w = (self.k / mu).sqrt();
+        (w, self.c / (2.0 * mu * w))
+    }
 }
 
 fn interp_clamped(xp: &[f64], fp: &[f64], x: f64) -> f64 {
@@ -185,6 +225,10 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
             lag_w: None,
             delay: None,
             t0,
+            shape: None,
+            drag: 0.0,
+            deadband: None,
+            res: None,
         };
         for e in &m.effects {
             match e {
@@ -215,6 +259,21 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
                 Effect::Mass { .. } => {}
                 Effect::Delay { seconds } => p.delay = Some(*seconds),
                 Effect::CurrentLag { bandwidth_hz } => p.lag_w = Some(2.0 * PI * bandwidth_hz),
+                Effect::Resonance {
+                    frequency_hz,
+                    damping_ratio,
+                    load_fraction,
+                } => {
+                    p.res = Some(TwoMass::new(
+                        p.mass,
+                        *frequency_hz,
+                        *damping_ratio,
+                        *load_fraction,
+                    ))
+                }
+                Effect::Deadband { current } => p.deadband = Some(*current),
+                Effect::Drag { coefficient } => p.drag += coefficient,
+                Effect::StribeckShape { exponent } => p.shape = Some(*exponent),
             }
         }
         p.has_scale = !p.pos_scale.is_empty() || !p.drift.is_empty();
@@ -264,11 +323,63 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
     }
 
     #[inline(always)]
-    fn effect_force(&self, x: f64) -> f64 {
+    fn res(&self) -> Option<&TwoMass> {
+        if EXTRAS {
+            self.res.as_ref()
+        } else {
+            None
+        }
+    }
+
+    /// Position and velocity of the body that carries the friction and the effects:
+    /// the load with a `resonance`, else the one rigid body.
+    #[inline(always)]
+    fn load(&self, s: &State) -> (f64, f64) {
+        if self.res().is_some() {
+            (s.xl, s.vl)
+        } else {
+            (s.x, s.v)
+        }
+    }
+
+    /// `(g, F, zdot)` of the plant's friction (generalised Stribeck curve with a
+    /// `stribeck_shape`).
+    #[inline(always)]
+    fn friction(&self, z: f64, v: f64, scale: f64) -> (f64, f64, f64) {
+        if EXTRAS {
+            if let Some(e) = self.shape {
+                return self.fr.eval_shaped(z, v, scale, e);
+            }
+        }
+        self.fr.eval(z, v, scale)
+    }
+
+    /// The current that produces force: the `deadband` removes `current` from `|i|`.
+    #[inline(always)]
+    fn deadband(&self, i: f64) -> f64 {
+        if EXTRAS {
+            if let Some(c) = self.deadband {
+                return if i > c {
+                    i - c
+                } else if i < -c {
+                    i + c
+                } else {
+                    0.0
+                };
+            }
+        }
+        i
+    }
+
+    #[inline(always)]
+    fn effect_force(&self, x: f64, v: f64) -> f64 {
         let mut f = self.lin_a * x + self.lin_b;
         if EXTRAS {
             for &(a, w, ph) in &self.cogging {
                 f += a * (w * x + ph).sin();
+            }
+            if self.drag != 0.0 {
+                f += self.drag * v.abs() * v;
             }
         }
         f
@@ -277,8 +388,8 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
     #[inline(always)]
     fn accel(&self, fm: f64, x: f64, v: f64, z: f64, time: f64) -> (f64, f64, f64) {
         let s = self.scale(x, time);
-        let (g, f, zdot) = self.fr.eval(z, v, s);
-        ((fm - f - self.effect_force(x)) / self.mass, g, zdot)
+        let (g, f, zdot) = self.friction(z, v, s);
+        ((fm - f - self.effect_force(x, v)) / self.mass, g, zdot)
     }
 }
 
@@ -290,6 +401,9 @@ struct State {
     ia: f64,
     q: f64,
     fl: f64,
+    /// Load position and velocity (`resonance`; unused without it).
+    xl: f64,
+    vl: f64,
 }
 
 /// The factors of the motor update that depend only on the step length `h`, computed
@@ -361,7 +475,7 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
                 }
             }
         }
-        let fm = self.kf * s.ia;
+        let fm = self.kf * self.deadband(s.ia);
         match self.lag_w() {
             None => fm,
             Some(_) => {
@@ -383,19 +497,85 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
     ) {
         let h = ms.h;
         let fm = self.motor(s, ic, ms);
+        if let Some(r) = self.res() {
+            // two bodies: semi-implicit Euler for both, exact bristle update on the load
+            let (g, f) = at_state.unwrap_or_else(|| {
+                let (g, f, _) = self.friction(s.z, s.vl, self.scale(s.xl, time));
+                (g, f)
+            });
+            let fc = r.k * (s.x - s.xl) + r.c * (s.v - s.vl);
+            let am = (fm - fc) / r.mm;
+            let al = (fc - f - self.effect_force(s.xl, s.vl)) / r.ml;
+            s.z = self.fr.advance_z(s.z, s.vl, g, h);
+            s.v += am * h;
+            s.vl += al * h;
+            s.x += s.v * h;
+            s.xl += s.vl * h;
+            return;
+        }
         let (g, f) = at_state.unwrap_or_else(|| {
-            let (g, f, _) = self.fr.eval(s.z, s.v, self.scale(s.x, time));
+            let (g, f, _) = self.friction(s.z, s.v, self.scale(s.x, time));
             (g, f)
         });
-        let a = (fm - f - self.effect_force(s.x)) / self.mass;
+        let a = (fm - f - self.effect_force(s.x, s.v)) / self.mass;
         s.z = self.fr.advance_z(s.z, s.v, g, h);
         s.v += a * h;
         s.x += s.v * h;
     }
 
+    /// RK4 on `(x, v, xl, vl, z)` of the two-mass axis, the motor force held.
+    fn step_rk4_two_mass(&self, s: &mut State, fm: f64, r: &TwoMass, h: f64, time: f64) {
+        let d = |x: f64, v: f64, xl: f64, vl: f64, z: f64, tm: f64| {
+            let (_, f, zdot) = self.friction(z, vl, self.scale(xl, tm));
+            let fc = r.k * (x - xl) + r.c * (v - vl);
+            (
+                v,
+                (fm - fc) / r.mm,
+                vl,
+                (fc - f - self.effect_force(xl, vl)) / r.ml,
+                zdot,
+            )
+        };
+        let (x, v, xl, vl, z) = (s.x, s.v, s.xl, s.vl, s.z);
+        let k1 = d(x, v, xl, vl, z, time);
+        let k2 = d(
+            x + 0.5 * h * k1.0,
+            v + 0.5 * h * k1.1,
+            xl + 0.5 * h * k1.2,
+            vl + 0.5 * h * k1.3,
+            z + 0.5 * h * k1.4,
+            time + 0.5 * h,
+        );
+        let k3 = d(
+            x + 0.5 * h * k2.0,
+            v + 0.5 * h * k2.1,
+            xl + 0.5 * h * k2.2,
+            vl + 0.5 * h * k2.3,
+            z + 0.5 * h * k2.4,
+            time + 0.5 * h,
+        );
+        let k4 = d(
+            x + h * k3.0,
+            v + h * k3.1,
+            xl + h * k3.2,
+            vl + h * k3.3,
+            z + h * k3.4,
+            time + h,
+        );
+        s.x += h / 6.0 * (k1.0 + 2.0 * k2.0 + 2.0 * k3.0 + k4.0);
+        s.v += h / 6.0 * (k1.1 + 2.0 * k2.1 + 2.0 * k3.1 + k4.1);
+        s.xl += h / 6.0 * (k1.2 + 2.0 * k2.2 + 2.0 * k3.2 + k4.2);
+        s.vl += h / 6.0 * (k1.3 + 2.0 * k2.3 + 2.0 * k3.3 + k4.3);
+        s.z += h / 6.0 * (k1.4 + 2.0 * k2.4 + 2.0 * k3.4 + k4.4);
+    }
+
     fn step_rk4(&self, s: &mut State, ic: f64, ms: &MotorStep, time: f64) {
         let h = ms.h;
         let fm = self.motor(s, ic, ms);
+        if let Some(r) = self.res() {
+            self.step_rk4_two_mass(s, fm, r, h, time);
+            return;
+        }
         let d = |x: f64, v: f64, z: f64, tm: f64| {
             let (a, _, zdot) = self.accel(fm, x, v, z, tm);
             (v, a, zdot)
@@ -479,6 +659,63 @@ pub fn check_inputs(model: &Model, t: &[f64], drive: &Drive, opts: &SimOptions) 
     Ok(())
 }
 
+/// The longest plant step [s] of a run: one control period (or, in open loop, one mean
+/// sample interval) over `substeps`.
+fn max_step(model: &Model, t: &[f64], drive: &Drive, substeps: usize) -> f64 {
+    let n = t.len();
+    match (drive, &model.controller) {
+        (Drive::Position(_) | Drive::Speed(_), Some(c)) => 1.0 / (c.rate_hz * substeps as f64),
+        _ => (t[n - 1] - t[0]) / (n - 1) as f64 / substeps as f64,
+    }
+}
+
+/// Refuse a `resonance` too stiff for the plant step.
+///
+/// Semi-implicit Euler on the relative motion of motor and load (angular frequency `w`,
+/// damping ratio `zeta` of the free mode) is stable for
+/// `w*h < 2*(sqrt(1 + zeta^2) - zeta)`; the simulation asks for half of that, which
+/// keeps the mode's frequency and damping within a few per cent (`docs/DESIGN.md`).
+pub fn check_resonance_step(
+    model: &Model,
+    t: &[f64],
+    drive: &Drive,
+    opts: &SimOptions,
+) -> Result<()> {
+    for e in &model.effects {
+        if let Effect::Resonance {
+            frequency_hz,
+            damping_ratio,
+            load_fraction,
+        } = e
+        {
+            let tm = TwoMass::new(
+                model.total_mass(),
+                *frequency_hz,
+                *damping_ratio,
+                *load_fraction,
+            );
+            let (w, zeta) = tm.free_mode();
+            let limit = (1.0 + zeta * zeta).sqrt() - zeta;
+            let h = max_step(model, t, drive, opts.substeps);
+            if w * h > limit {
+                let need = (opts.substeps as f64 * w * h / limit).ceil();
+                return Err(Error::parameter(
+                    "substeps",
+                    opts.substeps as f64,
+                    format!(
+                        "is too few for the resonance effect: its free motor-load mode at \
+                         {:.1} Hz needs plant steps below {:.3} of its period; use \
+                         substeps >= {need} (or a higher control rate)",
+                        w / (2.0 * PI),
+                        limit / (2.0 * PI),
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Simulate the axis sampled at `t`.
 ///
 /// `keep_going` is called about every [`POLL_INTERVAL`] of run time; returning `false`
@@ -504,6 +741,7 @@ pub fn simulate(
     keep_going: &mut dyn FnMut() -> bool,
 ) -> Result<SimResult> {
     check_inputs(model, t, &drive, opts)?;
+    check_resonance_step(model, t, &drive, opts)?;
     // one instance of the event loop per kind of physics and integrator
     let plain = is_plain(model);
     let t0 = t[0];
@@ -569,6 +807,8 @@ fn run<const EXTRAS: bool, const RK4: bool>(
         ia: 0.0,
         q: 0.0,
         fl: 0.0,
+        xl: x_init,
+        vl: opts.v0,
     };
     let mut ff = ctrl
         .and_then(|c| c.feedforward.as_ref())
@@ -647,18 +887,19 @@ fn run<const EXTRAS: bool, const RK4: bool>(
             // Record the samples due now. The friction is evaluated here, under this
             // test: inside the loop below, the compiler would hoist the evaluation (an
             // exp()) out of it and run it at every event, sample or not.
-            let sc = phys.scale(s.x, time);
-            let (g, f, _) = phys.fr.eval(s.z, s.v, sc);
+            let (xl, vl) = phys.load(&s);
+            let sc = phys.scale(xl, time);
+            let (g, f, _) = phys.friction(s.z, vl, sc);
             // the next plant step starts from this state: it reuses (g, F)
             at_state = Some((g, f));
             let fm = phys.kf
-                * if phys.current_loop().is_some() {
+                * phys.deadband(if phys.current_loop().is_some() {
                     s.ia
                 } else if phys.delay().is_some() {
                     ic_eff_peek(&queue, ic_eff, time, tol)
                 } else {
                     ic_eff
-                };
+                });
             let i = if phys.current_loop().is_some() {
                 s.ia
             } else {
@@ -715,7 +956,11 @@ fn run<const EXTRAS: bool, const RK4: bool>(
                 phys.step_exact(&mut s, ic_eff, &ms, tj, at_state.take());
             }
         }
-        if !(s.x.is_finite() && s.v.is_finite() && s.z.is_finite()) {
+        if !(s.x.is_finite()
+            && s.v.is_finite()
+            && s.z.is_finite()
+            && (!EXTRAS || (s.xl.is_finite() && s.vl.is_finite())))
+        {
             return Err(Error::Data(format!(
                 "the simulation diverged at t = {time}: check the controller gains against the mass and the control rate"
             )));
