@@ -104,8 +104,8 @@ def test_resonance_frequency_response():
     fa = f[band][np.argmin(h[band])]
     band = (f > 45) & (f < 100)
     fr = f[band][np.argmax(h[band])]
-    assert fa == pytest.approx(f0, rel=0.03)
-    assert fr == pytest.approx(f0 / np.sqrt(1 - r), rel=0.03)
+    assert fa == pytest.approx(f0, rel=0.015)  # bin width 0.24 Hz
+    assert fr == pytest.approx(f0 / np.sqrt(1 - r), rel=0.015)
 
 
 def test_drag_and_shape_steady_sliding():
@@ -139,9 +139,11 @@ def read_csv(p: Path):
     return {k: np.asarray(a[k], dtype=float) for k in a.dtype.names}
 
 
-def dataset_agreement(name: str, which: str = "recording.csv"):
-    """(rms(i_sim - i_rec)/rms(i_rec), the same without the effect) on a dataset:
-    the model of the dataset plus its true effects, under the recorded x_ref."""
+def dataset_residuals(name: str, which: str):
+    """The dataset's model plus its true effects (and, second, without them) under the
+    recorded ``x_ref``: rms of the current and position differences to the record,
+    and an upper bound on the current's white measurement noise,
+    ``std(diff(i))/sqrt(2)``."""
     d = DATASETS / name
     model = json.loads((d / "model.json").read_text())
     truth = json.loads((d / "truth.json").read_text())
@@ -150,25 +152,35 @@ def dataset_agreement(name: str, which: str = "recording.csv"):
     for effects in (truth["effects"], []):
         model["effects"] = effects
         r = lugre.simulate(lugre.Model.from_dict(model), rec["t"], rec["x_ref"])
-        out.append(np.sqrt(np.mean((r.i - rec["i"]) ** 2)) / np.sqrt(np.mean(rec["i"] ** 2)))
-    return out
+        out.append((np.sqrt(np.mean((r.i - rec["i"]) ** 2)),
+                    np.sqrt(np.mean((r.x - rec["x"]) ** 2))))
+    noise = np.std(np.diff(rec["i"])) / np.sqrt(2)
+    return out[0], out[1], noise
 
 
-#: Largest normalised rms current difference accepted per dataset, and the smallest
-#: gain over the same model without the effect (measured values in the docstring).
-DATASET_LIMITS = {
-    "resonance": (0.10, 2.0),
-    "deadband": (0.10, 1.2),
-    "drag": (0.10, 2.0),
-    "stribeck_shape": (0.10, 1.2),
+#: Per dataset, which residual tells the effect apart ("i" current, "x" position) and
+#: the least ratio of that residual without the effect to the one with it. Measured
+#: (recording / holdout): resonance x 3.1 / 2.9 (its current differs by only 6 %, the
+#: PID hides a 22 Hz load mode from the current), deadband i 2.08 / 1.98, drag i 4.7 /
+#: 4.8, stribeck_shape i 1.40 / 1.84.
+DATASET_GAIN = {
+    "resonance": ("x", 2.5),
+    "deadband": ("i", 1.8),
+    "drag": ("i", 3.0),
+    "stribeck_shape": ("i", 1.3),
 }
 
 
 @pytest.mark.skipif(not DATASETS.is_dir(), reason="shared datasets not available")
-@pytest.mark.parametrize("name", sorted(DATASET_LIMITS))
+@pytest.mark.parametrize("name", sorted(DATASET_GAIN))
 @pytest.mark.parametrize("which", ["recording.csv", "holdout.csv"])
 def test_datasets_current_agrees(name, which):
-    with_effect, without = dataset_agreement(name, which)
-    limit, gain = DATASET_LIMITS[name]
-    assert with_effect < limit, (with_effect, without)
-    assert without > gain * with_effect, (with_effect, without)
+    """Records of an independent plant (1 kHz samples of a 10 kHz loop, noisy current):
+    with the true effect the simulated current matches the recorded one up to the
+    noise (rms difference at most 1.3 times the noise bound; measured 1.03-1.19, i.e.
+    1.9-4.1 % of the rms current), and clearly better than without it."""
+    (di, dx), (di0, dx0), noise = dataset_residuals(name, which)
+    assert di < 1.3 * noise, (di, noise)
+    kind, gain = DATASET_GAIN[name]
+    ratio = di0 / di if kind == "i" else dx0 / dx
+    assert ratio > gain, (kind, ratio)
