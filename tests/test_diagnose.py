@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import json
 import re
-import warnings
 
 import lugre
 import numpy as np
 import pytest
 from lugre.diagnosis import diagnose, evaluate, fit_inverse_dynamics, write_plots
 from lugre.diagnosis.synth import concealed
-from lugre.exceptions import DataError, UnitsWarning
+from lugre.exceptions import DataError
 
 
 @pytest.fixture(scope="module")
@@ -70,8 +69,13 @@ def test_every_effect_of_the_vocabulary(effect):
     e = truth.effects[0]
     f = dg.findings[0]
     alt = {a["effect"]: a["parameters"] for a in f.alternatives}
-    if effect in ("delay", "current_lag"):  # same first-order signature: both named
-        assert names == [f.effect] and {f.effect, *alt} == {"delay", "current_lag"}
+    if effect in ("delay", "current_lag"):
+        # same first-order signature: a delay when the record cannot tell them apart
+        # (the lag beside it), the lag when its attenuation shows
+        assert names == [f.effect] and f.effect in ("delay", effect)
+        assert {f.effect, *alt} <= {"delay", "current_lag"}
+        if f.effect != effect:
+            assert effect in alt
         p = f.parameters if f.effect == effect else alt[effect]
     else:
         assert names == [effect]
@@ -97,7 +101,7 @@ def test_every_effect_of_the_vocabulary(effect):
     elif effect == "mass":
         assert _near(p["delta"], e["delta"], rel=0.15)
     elif effect == "delay":
-        assert _near(p["seconds"], e["seconds"], abs_=8e-4)
+        assert _near(p["seconds"], e["seconds"], rel=0.3)
     elif effect == "current_lag":
         assert _near(p["bandwidth"], e["bandwidth"], rel=0.2)
 
@@ -167,13 +171,11 @@ def test_bad_input():
     with pytest.raises(DataError, match="one direction"):
         diagnose(_rec(x=np.linspace(0, 0.1, 2000)), m)
     t = np.arange(2000) * 1e-3
-    with warnings.catch_warnings(record=True) as w:
-        warnings.simplefilter("always")
-        try:
-            evaluate(_rec(x=50.0 * np.sin(2 * np.pi * t)), m)
-        except DataError:
-            pass
-    assert any(issubclass(x.category, UnitsWarning) and "millimetres" in str(x.message)
-               for x in w)
+    with pytest.raises(DataError, match="millimetres.*--x-unit mm"):
+        evaluate(_rec(x=50.0 * np.sin(2 * np.pi * t)), m)
+    keep = np.sort(np.random.default_rng(0).permutation(2000)[:1400])  # 30 % rows lost
+    with pytest.raises(DataError, match=r"gap.*row.*--resample"):
+        diagnose(lugre.Recording(t=t[keep], x=0.05 * np.sin(2 * np.pi * t[keep]),
+                                 i=np.ones(1400)), m)
     with pytest.raises(FileNotFoundError):
         diagnose("/nonexistent/recording.csv", m)

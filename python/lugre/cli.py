@@ -157,7 +157,7 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     if not args.no_refine:
         # refine every base parameter with the bristle state simulated along the measured
         # velocity (the diagnosis's base re-estimation, with no extra physics)
-        refined = diagnose(rec, model, candidates=[]).augmented_model()
+        refined = diagnose(rec, model, candidates=[], free_mass=True).augmented_model()
         if args.mass:
             refined = refined.replace(axis={**refined.axis, "mass": args.mass})
         after = evaluate(rec, refined)["nrmse_force"]

@@ -10,7 +10,9 @@ show the fit improve.
 
 from __future__ import annotations
 
-from .core import diagnose, evaluate, fit_inverse_dynamics, locate
+from .core import diagnose, evaluate
+from .inverse import fit_inverse_dynamics
+from .locate import locate
 from .plots import write_plots
 from .report import Diagnosis, Finding
 

@@ -3,8 +3,8 @@
 Every candidate turns into columns ``X`` such that the residual of the model without
 the effect is ``r ~ X @ beta`` (to first order), and ``beta`` maps back to the
 effect's parameters. The base LuGre parameters enter the same way through the Jacobian
-of the model force (:func:`base_jacobian`), so that effects and base parameters are
-fitted jointly.
+of the model force, so that effects and base parameters are
+fitted jointly (:mod:`lugre.diagnosis.base`).
 
 ========================  =================================================================
 candidate                 signature (column)
@@ -34,136 +34,7 @@ import numpy as np
 from ..model import Model
 from .residual import Signals, base_friction
 
-__all__ = [
-    "BASE_PARAMS",
-    "Candidate",
-    "Context",
-    "apply_base",
-    "base_jacobian",
-    "candidates",
-]
-
-#: Base parameters re-estimated alongside, and their tolerance (relative std of the
-#: prior: how far a parameter of a model that is "about right" may move).
-BASE_PARAMS: tuple[tuple[str, float], ...] = (
-    ("mass", 0.03),
-    ("positive.fc", 0.03),
-    ("positive.fs", 0.03),
-    ("positive.sigma2", 0.03),
-    ("positive.vs", 0.1),
-    ("negative.fc", 0.03),
-    ("negative.fs", 0.03),
-    ("negative.sigma2", 0.03),
-    ("negative.vs", 0.1),
-    ("sigma0", 0.3),
-    ("sigma1", 0.3),
-)
-
-
-def get_base(model: Model, name: str) -> float:
-    """Value of a base parameter by its path (``mass``, ``positive.fc``, ``sigma0``)."""
-    if name == "mass":
-        return float(model.mass)
-    f = model.friction
-    if "." in name:
-        d, k = name.split(".")
-        return float(f[d][k])
-    return float(f[name])
-
-
-def apply_base(model: Model, values: dict[str, float]) -> Model:
-    """A copy of ``model`` with base parameters set (kept valid: ``fs >= fc`` etc.).
-
-    Parameters
-    ----------
-    model : Model
-        The model.
-    values : dict
-        New values by path.
-
-    Returns
-    -------
-    Model
-    """
-    d = model.to_dict()
-    f = d["friction"]
-    for name, val in values.items():
-        val = float(val)
-        if name == "mass":
-            d["axis"]["mass"] = max(val, 1e-6)
-        elif "." in name:
-            a, k = name.split(".")
-            f[a][k] = val
-        else:
-            f[name] = val
-    for side in ("positive", "negative"):
-        s = f[side]
-        s["fc"] = max(float(s["fc"]), 1e-9)
-        s["fs"] = max(float(s["fs"]), float(s["fc"]))
-        s["vs"] = max(float(s["vs"]), 1e-6)
-        s["sigma2"] = max(float(s["sigma2"]), 0.0)
-    f["sigma0"] = max(float(f["sigma0"]), 1.0)
-    f["sigma1"] = max(float(f["sigma1"]), 0.0)
-    return Model(d)
-
-
-def base_jacobian(model: Model, sig: Signals, fr0: np.ndarray | None = None
-                  ) -> tuple[np.ndarray, list[str], np.ndarray, np.ndarray]:
-    """Jacobian of the filtered model force with respect to the base parameters.
-
-    Parameters
-    ----------
-    model : Model
-        The model at which to linearise (its effects included).
-    sig : Signals
-        The prepared recording.
-    fr0 : numpy.ndarray, optional
-        ``base_friction(model, sig)`` if already computed.
-
-    Returns
-    -------
-    J : numpy.ndarray
-        ``(n, q)``, filtered.
-    names : list of str
-        Parameter paths (identifiable ones only).
-    theta : numpy.ndarray
-        Current values.
-    tol : numpy.ndarray
-        Prior standard deviations (absolute).
-    """
-    if fr0 is None:
-        fr0 = base_friction(model, sig)
-    cols: list[np.ndarray] = []
-    names: list[str] = []
-    theta: list[float] = []
-    tol: list[float] = []
-    mass_fixed = getattr(model, "_diagnose_mass_fixed", False)
-    for name, rel in BASE_PARAMS:
-        th = get_base(model, name)
-        if name == "mass":
-            if mass_fixed:
-                continue
-            col = sig.a.copy()
-            cols.append(col)
-        else:
-            side, key = (name.split(".") + [""])[:2] if "." in name else ("", name)
-            if key == "vs" and abs(model.friction[side]["fs"] - model.friction[side]["fc"]) < (
-                1e-3 * model.friction[side]["fc"]
-            ):
-                continue  # no Stribeck hump: vs does nothing
-            h = 1e-4 * max(abs(th), 1e-9)
-            if key == "fc":
-                h = -h  # keep fs >= fc
-            m2 = apply_base(model, {name: th + h})
-            col = (base_friction(m2, sig) - fr0) / h
-            if not np.any(np.abs(col) > 0):
-                continue
-            cols.append(sig.filt(col))
-        names.append(name)
-        theta.append(th)
-        tol.append(rel * max(abs(th), 1e-12))
-    return np.column_stack(cols), names, np.array(theta), np.array(tol)
-
+__all__ = ["Candidate", "Context", "candidates"]
 
 @dataclass
 class Context:
@@ -228,6 +99,10 @@ class Candidate:
         """Prior standard deviation of each coefficient (``None``: flat)."""
         return None
 
+    def prior_center(self, h: Any, ctx: Context) -> np.ndarray | None:
+        """Prior mean of each coefficient (``None``: 0)."""
+        return None
+
     def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
         """The effect objects for coefficients ``beta``."""
         raise NotImplementedError
@@ -235,6 +110,45 @@ class Candidate:
     def where(self, h: Any, beta: np.ndarray, ctx: Context) -> dict[str, Any]:
         """Position, time and velocity ranges where the effect lives (``None``: all)."""
         return {"position": None, "time": None, "velocity": None}
+
+    def recenter(self, h: Any, beta: np.ndarray, ctx: Context) -> tuple[Any, np.ndarray]:
+        """Re-linearise a nonlinear parameter at the fitted point (identity for linear
+        terms)."""
+        return h, beta
+
+    def fine_grid(self, best: Any, grid: np.ndarray) -> np.ndarray | None:
+        """Second, finer grid around the best point of :meth:`grid` (log-spaced default)."""
+        j = int(np.argmin(np.abs(grid - best)))
+        lo = grid[max(j - 1, 0)]
+        hi = grid[min(j + 1, grid.size - 1)]
+        return np.geomspace(lo, hi, 11)[1:-1] if hi > lo else None
+
+    def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
+        """A sentence on the fitted effect for the evidence (may be empty)."""
+        return ""
+
+    def uncertainty(self, term: Any, beta: np.ndarray, ctx: Context, sig: Signals,
+                    s2: float) -> dict[str, Any]:
+        """Intervals of the parameters the record determines (empty: none stated)."""
+        return {}
+
+    def figure(self, residual: np.ndarray, contrib: np.ndarray, ctx: Context
+               ) -> dict[str, Any]:
+        """Data of the figure of the fitted effect over the residual it explains."""
+        m = ctx.sig.mask
+        return {"x": ctx.sig.t[m], "xlabel": "time [s]", "residual": residual[m],
+                "effect": contrib[m]}
+
+
+def _by(key: str, xlabel: str):  # figure against position or velocity
+    def figure(self: Candidate, residual: np.ndarray, contrib: np.ndarray, ctx: Context
+               ) -> dict[str, Any]:
+        m = ctx.sig.mask
+        x = (ctx.sig.x if key == "x" else ctx.sig.vf)[m]
+        o = np.argsort(x, kind="stable")
+        return {"x": x[o], "xlabel": xlabel, "residual": residual[m][o],
+                "effect": contrib[m][o]}
+    return figure
 
 
 class Offset(Candidate):
@@ -270,6 +184,8 @@ class Spring(Candidate):
     def where(self, h: Any, beta: np.ndarray, ctx: Context) -> dict[str, Any]:
         return {"position": list(ctx.xrange), "time": None, "velocity": None}
 
+    figure = _by("x", "position [m]")
+
 
 class Mass(Candidate):
     effect = "mass"
@@ -287,17 +203,28 @@ class Cogging(Candidate):
     signature = "a force periodic in position, independent of the direction of motion"
 
     def _kgrid(self, ctx: Context) -> np.ndarray:
-        sig = ctx.sig
+        """Spatial frequencies [1/m] the record resolves.
+
+        Up to what the slow, well-moving fifth of the record passes within the filter
+        band (a pitch ``p`` crossed at speed ``v`` is a force at ``v/p`` Hz), and at
+        least 20 encoder counts a period; down to 1.5 periods over the stroke.
+        """
         span = max(ctx.xrange[1] - ctx.xrange[0], 1e-9)
-        moving = np.abs(sig.vf[sig.mask])
-        moving = moving[moving > 0.05 * max(moving.max(), 1e-12)]
-        vtyp = float(np.median(moving)) if moving.size else 1.0
-        q = max(sig.info.get("quantum", 0.0), 1e-9)
-        kmax = min(1.0 / (20.0 * q), 0.7 * sig.cutoff_hz / max(vtyp, 1e-9), 400.0 / span)
+        kmax = self.kmax(ctx)
         kmin = 1.5 / span
         if kmax <= kmin:
             return np.array([])
         return np.arange(kmin, kmax, 0.25 / span)
+
+    @staticmethod
+    def kmax(ctx: Context) -> float:
+        """Highest spatial frequency [1/m] the record resolves (see :meth:`_kgrid`)."""
+        sig = ctx.sig
+        moving = np.abs(sig.vf[sig.mask])
+        moving = moving[moving > 0.05 * max(float(moving.max()), 1e-12)]
+        v_slow = float(np.percentile(moving, 20)) if moving.size else 1.0
+        q = max(sig.info.get("quantum", 0.0), 1e-9)
+        return min(1.0 / (20.0 * q), 0.7 * sig.cutoff_hz / max(v_slow, 1e-9))
 
     @staticmethod
     def _power(r: np.ndarray, x: np.ndarray, ks: np.ndarray) -> np.ndarray:
@@ -312,20 +239,31 @@ class Cogging(Candidate):
 
     def choose(self, r: np.ndarray, ctx: Context) -> Any:
         ks = self._kgrid(ctx)
+        lead = ctx.extra.get("screw_lead")
         if ks.size == 0:
             return None
         m = ctx.sig.mask
         step = max(1, int(m.sum() // 6000))
         x = ctx.sig.x[m][::step]
         rr = r[m][::step] - np.mean(r[m])
-        p = self._power(rr, x, ks)
+        p = np.concatenate([self._power(rr, x, ks[j:j + 200])
+                            for j in range(0, ks.size, 200)])
         k0 = ks[int(np.argmax(p))]
         span = ctx.xrange[1] - ctx.xrange[0]
         fine = np.linspace(k0 - 0.3 / span, k0 + 0.3 / span, 31)
+        if lead:  # one revolution of the screw and its harmonics: always tried
+            fine = np.concatenate([fine, np.arange(1, 5) / float(lead)])
         pf = self._power(rr, x, fine)
         k1 = float(fine[int(np.argmax(pf))])
         self.spectrum = (ks, p)
         return 1.0 / k1
+
+    def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
+        return (f"The residual's spectrum over position peaks at a pitch of {h * 1e3:.4g} mm "
+                f"(searched from {1e3 / self.kmax(ctx):.3g} mm, what the slowest fifth of "
+                "the motion resolves in the filter band, to the stroke).")
+
+    figure = _by("x", "position [m]")
 
     def columns(self, h: Any, ctx: Context) -> np.ndarray:
         ph = 2.0 * np.pi * ctx.sig.x / h
@@ -377,6 +315,9 @@ class PositionFriction(Candidate):
         return {"position": [float(lo), float(hi)], "time": None, "velocity": None}
 
 
+PositionFriction.figure = _by("x", "position [m]")  # type: ignore[method-assign]
+
+
 class Drift(Candidate):
     effect = "drift"
     signature = ("a trend in time of the Coulomb/static friction level (its sign follows "
@@ -407,7 +348,8 @@ class Drift(Candidate):
 
 
 class Lag(Candidate):
-    """``delay`` and ``current_lag``: the same first-order signature, told apart later."""
+    """``delay`` and ``current_lag``: the same first-order signature, told apart later
+    (:mod:`lugre.diagnosis.timing`)."""
 
     effect = "delay"
     signature = "a force proportional to the rate of change of the motor force (a lag)"
@@ -421,7 +363,231 @@ class Lag(Candidate):
             return [{"effect": "current_lag", "bandwidth": 1.0 / (2 * math.pi * max(tau, 1e-9))}]
         return [{"effect": "delay", "seconds": max(tau, 0.0)}]
 
+    def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
+        tau = float(beta[0])
+        zoh = 0.5 * ctx.sig.dt
+        return (f"The force follows the recorded current by {tau * 1e3:.2g} ms on average "
+                f"(effective delay); if the current was logged at the rate the controller "
+                f"updates it, {zoh * 1e3:.2g} ms of this is the zero-order hold of the "
+                "logged command and the rest is the drive.")
+
+    def uncertainty(self, term: Any, beta: np.ndarray, ctx: Context, sig: Signals,
+                    s2: float) -> dict[str, Any]:
+        return {"effective_delay_s": float(beta[0]), "zero_order_hold_s": 0.5 * sig.dt}
+
+
+class Drag(Candidate):
+    effect = "drag"
+    signature = ("a force growing with the square of the speed, opposing the motion "
+                 "(seals, churning lubricant)")
+
+    def columns(self, h: Any, ctx: Context) -> np.ndarray:
+        v = ctx.sig.v
+        return ctx.sig.filt(np.abs(v) * v)[:, None]
+
+    def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
+        return [{"effect": "drag", "coefficient": float(beta[0])}]
+
+    def where(self, h: Any, beta: np.ndarray, ctx: Context) -> dict[str, Any]:
+        vm = float(np.max(np.abs(ctx.sig.vf[ctx.sig.mask])))
+        return {"position": None, "time": None, "velocity": [-vm, vm]}
+
+    figure = _by("v", "velocity [m/s]")
+
+
+class _Secant(Candidate):
+    """An effect with a nonlinear parameter ``h``, searched over a grid.
+
+    Its column is the change of the residual that the effect at ``h`` makes (the
+    secant), with a coefficient near 1 when ``h`` is right; :meth:`from_secant` maps a
+    coefficient to the parameter it stands for, and the joint refit re-linearises there.
+    """
+
+    needs_grid = True
+
+    def effect_at(self, h: Any) -> dict[str, Any]:
+        raise NotImplementedError
+
+    def from_secant(self, h: Any, b: float) -> Any:
+        return h
+
+    def columns(self, h: Any, ctx: Context) -> np.ndarray:
+        from . import residual as R
+
+        key = ("r_base", id(ctx.model))
+        if key not in ctx.extra:
+            ctx.extra[key] = R.residual(ctx.model, ctx.sig)
+        m1 = ctx.model.replace(effects=list(ctx.model.effects) + [self.effect_at(h)])
+        return (ctx.extra[key] - R.residual(m1, ctx.sig))[:, None]
+
+    def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
+        return [self.effect_at(self.from_secant(h, float(beta[0])))]
+
+    def recenter(self, h: Any, beta: np.ndarray, ctx: Context) -> tuple[Any, np.ndarray]:
+        return self.from_secant(h, float(beta[0])), np.ones(1)
+
+    def uncertainty(self, term: Any, beta: np.ndarray, ctx: Context, sig: Signals,
+                    s2: float) -> dict[str, Any]:
+        pr = term.profile
+        if pr is None:
+            return {}
+        ok = pr["score"] <= pr["score"].min() + 10.0
+        out: dict[str, Any] = {"criterion": "held-out score within 10 of the best"}
+        hs = [self.from_secant(h, float(b[0])) for h, b in zip(pr["h_obj"], pr["beta"])]
+        for name, vals in self.interval_params(hs, ok).items():
+            out[name] = vals
+        return out
+
+    def interval_params(self, hs: list[Any], ok: np.ndarray) -> dict[str, list[float]]:
+        vals = np.array([float(h) for h in hs])[ok]
+        return {self.param: [float(vals.min()), float(vals.max())]}
+
+    param = ""
+
+
+class StribeckShape(_Secant):
+    effect = "stribeck_shape"
+    param = "exponent"
+    signature = ("a Stribeck curve of another shape: the friction falls from its static to "
+                 "its Coulomb level more gradually (exponent under 2) or more abruptly")
+
+    def grid(self, ctx: Context) -> np.ndarray | None:
+        return np.array([0.5, 0.65, 0.8, 1.0, 1.25, 1.55, 2.6, 3.3, 4.2])
+
+    def effect_at(self, h: Any) -> dict[str, Any]:
+        return {"effect": "stribeck_shape", "exponent": float(h)}
+
+    def from_secant(self, h: Any, b: float) -> Any:
+        return float(np.clip(2.0 + b * (float(h) - 2.0), 0.2, 10.0))
+
+    def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
+        return "It lives at slow speeds, where the friction falls from static to Coulomb."
+
+    figure = _by("v", "velocity [m/s]")
+
+
+class Deadband(_Secant):
+    effect = "deadband"
+    param = "current"
+    signature = ("a dead-band of the drive: small currents give no force, so the motor "
+                 "force lags the command at every change of the current's sign")
+
+    def grid(self, ctx: Context) -> np.ndarray | None:
+        ia = np.abs(ctx.sig.fm[ctx.sig.mask]) / ctx.model.force_constant
+        top = float(np.percentile(ia, 50))
+        if not top > 0:
+            return None
+        return top * np.geomspace(0.01, 0.8, 12)
+
+    def effect_at(self, h: Any) -> dict[str, Any]:
+        return {"effect": "deadband", "current": float(h)}
+
+    def columns(self, h: Any, ctx: Context) -> np.ndarray:
+        if any(e["effect"] in ("delay", "current_lag", "deadband") for e in ctx.model.effects):
+            return super().columns(h, ctx)
+        from .residual import deadband
+
+        sig = ctx.sig
+        # r(without) - r(with): only the motor force changes
+        return (sig.fm_f - sig.filt(deadband(sig.fm, float(h) * ctx.model.force_constant))
+                )[:, None]
+
+    def from_secant(self, h: Any, b: float) -> Any:
+        return float(max(b * float(h), 0.0))
+
+    def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
+        d = self.from_secant(h, float(beta[0]))
+        return (f"Currents under {d * 1e3:.3g} mA give no force ({d * ctx.model.force_constant:.3g}"
+                " N of motor force lost at each sign change of the current).")
+
+    def figure(self, residual: np.ndarray, contrib: np.ndarray, ctx: Context
+               ) -> dict[str, Any]:
+        m = ctx.sig.mask
+        i = ctx.sig.fm_f[m] / ctx.model.force_constant
+        o = np.argsort(i, kind="stable")
+        return {"x": i[o], "xlabel": "current [A]", "residual": residual[m][o],
+                "effect": contrib[m][o]}
+
+
+class Resonance(_Secant):
+    effect = "resonance"
+    signature = ("a compliant coupling: the load the encoder does not see swings against "
+                 "the motor at the coupling's natural frequency")
+
+    def grid(self, ctx: Context) -> np.ndarray | None:
+        top = 0.8 * ctx.sig.cutoff_hz
+        if top <= 5.0:
+            return None
+        fs = np.geomspace(5.0, top, 14)
+        g = [(f, z, r) for f in fs for z in (0.03, 0.1, 0.3) for r in (0.3, 0.6, 0.85)]
+        out = np.empty(len(g), dtype=object)
+        out[:] = g
+        return out
+
+    def prior_tol(self, h: Any, ctx: Context) -> np.ndarray | None:
+        return np.full(1, 1e-6)  # the effect at h exactly: its parameters come from the grid
+
+    def prior_center(self, h: Any, ctx: Context) -> np.ndarray | None:
+        return np.ones(1)
+
+    def fine_grid(self, best: Any, grid: np.ndarray) -> np.ndarray | None:
+        f, z, r = best
+        g = [(f * a, z * b, float(np.clip(r + c, 0.05, 0.95)))
+             for a in (0.88, 0.94, 1.0, 1.06, 1.13) for b in (0.6, 1.0, 1.6)
+             for c in (-0.12, 0.0, 0.12)]
+        out = np.empty(len(g), dtype=object)
+        out[:] = g
+        return out
+
+    def columns(self, h: Any, ctx: Context) -> np.ndarray:
+        if any(e["effect"] == "resonance" for e in ctx.model.effects):
+            return super().columns(h, ctx)
+        from scipy import signal
+
+        from . import residual as R
+
+        sig = ctx.sig
+        key = ("load_force", id(ctx.model))
+        if key not in ctx.extra:  # filtered friction and effect forces of the base
+            m = R.total_mass(ctx.model)
+            ctx.extra[key] = (m, R.model_force(ctx.model, sig) - m * sig.a)
+        m, ffr = ctx.extra[key]
+        f, z, r = h
+        b, a = R.coupling(f, z, sig.dt, R.load_damping(ctx.model, r))
+        u = r * m * sig.a + ffr
+        passed = signal.lfilter(b, a, u, zi=signal.lfilter_zi(b, a) * u[0])[0]
+        # r(without) - r(with) = model force with the coupling - without it
+        return ((1.0 - r) * m * sig.a + passed - (m * sig.a + ffr))[:, None]
+
+    def effect_at(self, h: Any) -> dict[str, Any]:
+        f, z, r = h
+        return {"effect": "resonance", "frequency": float(f), "damping_ratio": float(z),
+                "load_fraction": float(r)}
+
+    def interval_params(self, hs: list[Any], ok: np.ndarray) -> dict[str, list[float]]:
+        a = np.array([list(h) for h in hs], dtype=float)[ok]
+        return {k: [float(a[:, j].min()), float(a[:, j].max())]
+                for j, k in enumerate(("frequency", "damping_ratio", "load_fraction"))}
+
+    def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
+        f, z, r = h
+        return (f"A load of {100 * r:.0f} % of the mass on a coupling of {f:.3g} Hz "
+                f"(damping ratio {z:.2g}).")
+
+    def figure(self, residual: np.ndarray, contrib: np.ndarray, ctx: Context
+               ) -> dict[str, Any]:
+        from scipy import signal
+
+        m = ctx.sig.mask
+        nper = int(min(m.sum(), 2048))
+        f, pr = signal.welch(residual[m], fs=ctx.sig.fs, nperseg=nper)
+        _, pe = signal.welch(contrib[m], fs=ctx.sig.fs, nperseg=nper)
+        keep = f <= ctx.sig.cutoff_hz
+        return {"x": f[keep], "xlabel": "frequency [Hz]", "residual": np.sqrt(pr[keep]),
+                "effect": np.sqrt(pe[keep]), "ylabel": "force density [N/sqrt(Hz)]"}
+
 
 def candidates() -> list[Candidate]:
     """A fresh list of every candidate of the vocabulary."""
-    return [Offset(), Spring(), Mass(), Cogging(), PositionFriction(), Drift(), Lag()]
+    return [Offset(), Spring(), Mass(), Cogging(), PositionFriction(), Drift(), Lag(),
+            Drag(), StribeckShape(), Deadband(), Resonance()]

@@ -120,8 +120,14 @@ class Diagnosis:
     unexplained: dict[str, Any] | None = None
     notes: list[str] = field(default_factory=list)
     trials: list[dict[str, Any]] = field(default_factory=list)
-    data: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
+    data: dict[str, Any] = field(default_factory=dict, repr=False)
     timing: float = 0.0
+    #: per effect not found, the smallest size this record would have revealed
+    could_not_reveal: list[dict[str, Any]] = field(default_factory=list)
+    #: base parameters that moved by more than two tolerances, in words
+    base_moves: list[dict[str, Any]] = field(default_factory=list)
+    #: the verdict in one paragraph
+    verdict: str = ""
 
     def augmented_model(self) -> Model:
         """The model with the findings added to ``effects`` and the base re-estimated."""
@@ -130,6 +136,7 @@ class Diagnosis:
     def to_dict(self) -> dict[str, Any]:
         """REPORT.json (CONTRACT shape, plus ``noise``, ``base``, ``located``, ...)."""
         d: dict[str, Any] = {
+            "verdict": self.verdict,
             "findings": [f.to_dict() for f in self.findings],
             "fit": _plain(self.fit),
             "noise": _plain(self.noise),
@@ -137,6 +144,8 @@ class Diagnosis:
             "located": _plain(self.located),
             "unexplained": _plain(self.unexplained),
             "notes": list(self.notes),
+            "base_moves": _plain(self.base_moves),
+            "could_not_reveal": _plain(self.could_not_reveal),
             "trials": [
                 {k: _plain(v) for k, v in t.items() if k in (
                     "step", "effect", "gain", "p", "positive", "contrib", "accepted", "why")}
@@ -151,7 +160,7 @@ class Diagnosis:
 
     def summary(self) -> str:
         """A plain-text report for a control engineer."""
-        lines: list[str] = []
+        lines: list[str] = [self.verdict] if self.verdict else []
         fb, fa = self.fit["before"], self.fit["after"]
         lines.append(
             f"Noise floor {self.noise['rms']:.3g} N rms (n_eff {self.noise['n_eff']:.0f}). "
@@ -190,6 +199,9 @@ class Diagnosis:
                  if abs(b["change"]) > 0.005]
         if moved:
             lines.append("Base parameters re-estimated: " + ", ".join(moved) + ".")
+        if self.could_not_reveal:
+            lines.append("What this record could have hidden: " + "; ".join(
+                h["text"] for h in self.could_not_reveal) + ".")
         if self.unexplained:
             u = self.unexplained
             lines.append(f"Unexplained: {u['message']}")

@@ -14,6 +14,7 @@ so the residual holds no filter artefacts).
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -29,13 +30,14 @@ from ..model import Model, _as_model
 
 __all__ = [
     "Signals",
+    "bristles",
     "check_recording",
     "lowpass",
+    "lugre_at",
     "model_force",
     "noise_floor",
     "prepare",
     "residual",
-    "scaled_friction",
 ]
 
 #: Fewest samples a diagnosis accepts.
@@ -63,8 +65,15 @@ def lowpass(y: np.ndarray, cutoff_hz: float, fs: float, order: int = 4) -> np.nd
     wn = cutoff_hz / (0.5 * fs)
     if wn >= 0.99:
         return np.array(y, dtype=float, copy=True)
+    return signal.sosfiltfilt(_butter(order, wn).copy(), y, axis=0, padtype="odd",
+                              padlen=min(3 * 24, len(y) - 1))
+
+
+@functools.lru_cache(maxsize=16)
+def _butter(order: int, wn: float) -> np.ndarray:
     sos = signal.butter(order, wn, output="sos")
-    return signal.sosfiltfilt(sos, y, axis=0, padtype="odd", padlen=min(3 * 24, len(y) - 1))
+    sos.flags.writeable = False
+    return sos
 
 
 def hampel(y: np.ndarray, half_window: int = 5, k: float = 5.0) -> tuple[np.ndarray, np.ndarray]:
@@ -202,12 +211,16 @@ def check_recording(rec: Recording, model: Model | None = None) -> None:
     if rec.i is None and rec.F is None:  # pragma: no cover - Recording refuses it
         raise InputError.at("i", "the recording has neither the current i nor the force F")
     dts = np.diff(rec.t)
-    if np.max(dts) > 1.5 * np.median(dts) * 1.0001 + 1e-12:
-        warnings.warn(
-            "the sample interval of the recording varies by more than 50 %; it is "
-            "treated as uniform at the median interval",
-            UnitsWarning,
-            stacklevel=3,
+    med = float(np.median(dts))
+    long = np.flatnonzero(dts > 1.5 * med * 1.0001 + 1e-12)
+    if long.size:
+        j = int(long[np.argmax(dts[long])])
+        raise DataError(
+            f"the sampling of the recording has {long.size} gap(s) longer than 1.5 times the "
+            f"sample interval {med:.4g} s (the longest {dts[j]:.4g} s after t = "
+            f"{rec.t[j]:.6g} s, data row {j + 1}): derivatives across a gap are meaningless. "
+            "Diagnose each gap-free stretch separately, or resample onto a uniform grid "
+            "(lugre diagnose --resample) if the gaps are short against the motion"
         )
     span = float(np.ptp(rec.x))
     steps = np.abs(np.diff(rec.x))
@@ -217,15 +230,14 @@ def check_recording(rec: Recording, model: Model | None = None) -> None:
             "the recording shows no motion (position range "
             f"{span:.3g} m): a diagnosis needs the axis moving, ideally in both directions"
         )
-    v = np.diff(rec.x) / np.median(dts)
+    v = np.diff(rec.x) / med
     vmax = float(np.max(np.abs(v)))
     if vmax > 20.0 or span > 20.0:
-        warnings.warn(
+        raise DataError(
             f"the positions span {span:.4g} and the speed reaches {vmax:.4g} per second: "
-            "this looks like millimetres, but models are in metres. Convert x to metres "
-            "(divide by 1000) before diagnosing.",
-            UnitsWarning,
-            stacklevel=3,
+            "this looks like millimetres (or counts), but positions are in metres. Convert "
+            "x to metres: --x-unit mm, or a column expression such as --columns "
+            "'x=x/1000'"
         )
     if model is not None:
         vs = min(model.positive["vs"], model.negative["vs"])
@@ -324,74 +336,142 @@ def friction_scale(model: Model, sig: Signals) -> np.ndarray | None:
     return s
 
 
-def scaled_friction(v: np.ndarray, dt: float, model: Model, scale: np.ndarray) -> np.ndarray:
-    """LuGre force with ``g`` multiplied by ``scale[k]`` at each sample (exact update).
+def _g(model: Model, v: np.ndarray, scale: np.ndarray | None, exponent: float) -> np.ndarray:
+    f = model.friction
+    pos, neg = f["positive"], f["negative"]
+    vp = np.maximum(v, 0.0)
+    vn = np.minimum(v, 0.0)
+    gp = pos["fc"] + (pos["fs"] - pos["fc"]) * np.exp(-np.abs(vp / pos["vs"]) ** exponent)
+    gn = neg["fc"] + (neg["fs"] - neg["fc"]) * np.exp(-np.abs(vn / neg["vs"]) ** exponent)
+    g = np.where(v >= 0, gp, gn)
+    return g if scale is None else g * scale
+
+
+def bristles(v: np.ndarray, dt: float, model: Model, scale: np.ndarray | None,
+             exponent: float = 2.0) -> np.ndarray:
+    """Bristle state ``z[k]`` at the sample instants, advanced exactly over each sample
+    interval with ``v`` held (``scale`` multiplies ``g`` per sample, ``exponent`` is the
+    Stribeck exponent).
 
     Parameters
     ----------
     v : numpy.ndarray
-        Velocity driving the bristles [m/s].
+        Velocity held over each interval ``[t_k, t_k+1)`` [m/s].
     dt : float
         Sample interval [s].
     model : Model
         Friction parameters.
-    scale : numpy.ndarray
-        Scale of the Coulomb and static levels, one per sample.
+    scale : numpy.ndarray or None
+        Scale of the Coulomb and static levels, one per sample (None: 1).
+    exponent : float, default 2.0
+        Stribeck exponent (``stribeck_shape``).
 
     Returns
     -------
     numpy.ndarray
-        Friction force [N].
+        ``z[k]``, the state at ``t_k`` [m].
     """
-    f = model.friction
-    s0, s1 = float(f["sigma0"]), float(f["sigma1"])
-    pos, neg = f["positive"], f["negative"]
-    n = v.size
-    vp = np.maximum(v, 0.0)
-    vn = np.minimum(v, 0.0)
-    gp = pos["fc"] + (pos["fs"] - pos["fc"]) * np.exp(-(vp / pos["vs"]) ** 2)
-    gn = neg["fc"] + (neg["fs"] - neg["fc"]) * np.exp(-(vn / neg["vs"]) ** 2)
-    g = np.where(v >= 0, gp, gn) * scale
-    s2 = np.where(v >= 0, pos["sigma2"], neg["sigma2"])
-    av = np.abs(v)
+    if scale is None and exponent == 2.0:
+        fm = model.replace(effects=[]) if model.effects else model
+        return friction_force(v, dt, fm, return_z=True)[1]
+    s0 = float(model.friction["sigma0"])
+    g = _g(model, v, scale, exponent)
     zss = np.sign(v) * g / s0
-    dec = np.exp(-s0 * av * dt / g)
-    zs = np.empty(n)
+    dec = np.exp(-s0 * np.abs(v) * dt / g)
+    zs = np.empty(v.size)
     z = 0.0
     zss_l = zss.tolist()
     dec_l = dec.tolist()
-    for k in range(n):
+    for k in range(v.size):
         zs[k] = z
         z = zss_l[k] + (z - zss_l[k]) * dec_l[k]
-    zdot = v - s0 * av * zs / g
-    return s0 * zs + s1 * zdot + s2 * v
+    return zs
+
+
+def lugre_at(model: Model, v: np.ndarray, z: np.ndarray, scale: np.ndarray | None,
+             exponent: float = 2.0) -> np.ndarray:
+    """LuGre force at states ``z`` and velocities ``v``:
+    ``sigma0*z + sigma1*(v - sigma0*|v|*z/g(v)) + sigma2*v``."""
+    f = model.friction
+    s0, s1 = float(f["sigma0"]), float(f["sigma1"])
+    g = _g(model, v, scale, exponent)
+    s2 = np.where(v >= 0, f["positive"]["sigma2"], f["negative"]["sigma2"])
+    return s0 * z + s1 * (v - s0 * np.abs(v) * z / g) + s2 * v
+
+
+def stribeck_exponent(model: Model) -> float:
+    """The model's Stribeck exponent (``stribeck_shape``; 2 without it)."""
+    for e in model.effects:
+        if e["effect"] == "stribeck_shape":
+            return float(e["exponent"])
+    return 2.0
 
 
 def base_friction(model: Model, sig: Signals) -> np.ndarray:
-    """Unfiltered LuGre force (with position/drift scales when the model has them)."""
+    """Unfiltered LuGre force at the sample instants (with position/drift scales and the
+    Stribeck exponent when the model has them).
+
+    The bristles are advanced over each sample interval with the velocity at its middle
+    (the mean of the two samples), so that ``z[k]`` is the state at ``t_k``: advanced
+    with ``v[k-1]`` held it would trail the samples by half an interval, a force error
+    of ``sigma0*v*dt/2`` in presliding that reads as extra damping.
+    """
     s = friction_scale(model, sig)
-    if s is None:
-        return friction_force(sig.v, sig.dt, model)
-    return scaled_friction(sig.v, sig.dt, model, s)
+    n = stribeck_exponent(model)
+    v = sig.v
+    vh = np.empty_like(v)
+    vh[:-1] = 0.5 * (v[:-1] + v[1:])
+    vh[-1] = v[-1]
+    sh = None
+    if s is not None:
+        sh = np.empty_like(s)
+        sh[:-1] = 0.5 * (s[:-1] + s[1:])
+        sh[-1] = s[-1]
+    z = bristles(vh, sig.dt, model, sh, n)
+    return lugre_at(model, v, z, s, n)
+
+
+def lag_foh(f: np.ndarray, bandwidth_hz: float, dt: float) -> np.ndarray:
+    """First-order lag of a signal interpolated linearly between its samples (exact).
+
+    ``y[n] = c*y[n-1] + (1 - c)*f[n-1] + (1 - (1 - c)/a)*(f[n] - f[n-1])`` with
+    ``a = 2*pi*bandwidth*dt`` and ``c = exp(-a)``: the continuous lag of the
+    piecewise-linear signal, whose mean delay is ``1/(2*pi*bandwidth)`` whatever the
+    sample interval (the plain discrete lag ``c/(1-c)`` samples understates it).
+    """
+    a = 2.0 * math.pi * bandwidth_hz * dt
+    c = math.exp(-a)
+    b1 = 1.0 - (1.0 - c) / a
+    # y[n] = c*y[n-1] + b1*f[n] + (1 - c - b1)*f[n-1]
+    return signal.lfilter([b1, 1.0 - c - b1], [1.0, -c], f, zi=[(1.0 - b1) * f[0]])[0]
+
+
+def deadband(f: np.ndarray, band: float) -> np.ndarray:
+    """``sign(f)*max(|f| - band, 0)`` (a dead-band in force units)."""
+    return np.sign(f) * np.maximum(np.abs(f) - band, 0.0)
 
 
 def motor_force_effective(model: Model, sig: Signals) -> np.ndarray:
-    """The filtered motor force after the ``delay`` and ``current_lag`` effects."""
+    """The filtered motor force after the ``delay``, ``deadband`` and ``current_lag``
+    effects (in this order: the dead-band acts on the delayed command, the lag on the
+    force it gives)."""
     f = sig.fm
+    eff = {e["effect"]: e for e in model.effects}
     changed = False
-    for e in model.effects:
-        if e["effect"] == "delay" and e["seconds"] > 0:
-            f = np.interp(sig.t - e["seconds"], sig.t, f)
-            changed = True
-        elif e["effect"] == "current_lag":
-            c = math.exp(-2.0 * math.pi * e["bandwidth"] * sig.dt)
-            f = signal.lfilter([1.0 - c], [1.0, -c], f, zi=[c * f[0]])[0]
-            changed = True
+    if "delay" in eff and eff["delay"]["seconds"] > 0:
+        f = np.interp(sig.t - eff["delay"]["seconds"], sig.t, f)
+        changed = True
+    if "deadband" in eff and eff["deadband"]["current"] > 0:
+        f = deadband(f, eff["deadband"]["current"] * model.force_constant)
+        changed = True
+    if "current_lag" in eff:
+        f = lag_foh(f, eff["current_lag"]["bandwidth"], sig.dt)
+        changed = True
     return sig.filt(f) if changed else sig.fm_f
 
 
 def effect_force(model: Model, sig: Signals) -> np.ndarray:
-    """Unfiltered sum of the position forces (cogging, spring, offset)."""
+    """Unfiltered sum of the effect forces (cogging, spring, offset, drag)."""
     out = np.zeros(len(sig))
     x = sig.x
     for e in model.effects:
@@ -405,7 +485,35 @@ def effect_force(model: Model, sig: Signals) -> np.ndarray:
             out += e["stiffness"] * (x - e.get("x0", 0.0))
         elif k == "offset":
             out += e["force"]
+        elif k == "drag":
+            out += e["coefficient"] * np.abs(sig.v) * sig.v
     return out
+
+
+def coupling(frequency: float, damping_ratio: float, dt: float, extra_damping: float = 0.0
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """Discrete ``G(s) = (2*zeta*w*s + w^2)/(s^2 + (2*zeta*w + d)*s + w^2)`` (bilinear,
+    warped at the resonance, at most 0.45 of the sample rate): the force a spring-damper
+    passes to a load, per unit of the force the load needs; ``d`` [1/s] is the damping
+    the load's own viscous friction adds to its motion against the motor
+    (``sigma2/(r*m)``)."""
+    w = 2.0 * math.pi * frequency
+    f0 = min(frequency, 0.45 / dt)
+    w0 = 2.0 * math.pi * f0
+    K = w0 / math.tan(w0 * dt / 2.0)  # s -> K*(z - 1)/(z + 1)
+    a1, a0 = 2.0 * damping_ratio * w, w * w
+    d1 = a1 + extra_damping
+    # (a1*s + a0)/(s^2 + d1*s + a0) with s = K*(1 - q)/(1 + q), q = 1/z
+    b = np.array([a1 * K + a0, 2.0 * a0, a0 - a1 * K])
+    a = np.array([K * K + d1 * K + a0, 2.0 * a0 - 2.0 * K * K, K * K - d1 * K + a0])
+    return b / a[0], a / a[0]
+
+
+def load_damping(model: Model, load_fraction: float) -> float:
+    """Damping [1/s] of the load's motion against the motor from its viscous friction."""
+    f = model.friction
+    s2 = 0.5 * (f["positive"]["sigma2"] + f["negative"]["sigma2"])
+    return s2 / (load_fraction * total_mass(model))
 
 
 def total_mass(model: Model) -> float:
@@ -414,9 +522,25 @@ def total_mass(model: Model) -> float:
 
 
 def model_force(model: Model, sig: Signals) -> np.ndarray:
-    """Filtered force the model needs besides the motor: ``m*a + F_friction + F_effects``."""
+    """Filtered force the model needs besides the motor: ``m*a + F_friction + F_effects``.
+
+    With a ``resonance`` the encoder sees the motor, ``(1 - r)*m``, and the load
+    ``r*m`` carries the friction and the effect forces through a spring-damper: the
+    motor gives ``(1 - r)*m*a + G(r*m*a + F_load)``, ``G`` the coupling's transfer
+    (:func:`coupling`), to first order in the deflection (the load's friction taken
+    at the motor's velocity, its viscous part damping the deflection).
+    """
     fr = base_friction(model, sig) + effect_force(model, sig)
-    return total_mass(model) * sig.a + sig.filt(fr)
+    m = total_mass(model)
+    res = next((e for e in model.effects if e["effect"] == "resonance"), None)
+    if res is None:
+        return m * sig.a + sig.filt(fr)
+    r = float(res["load_fraction"])
+    b, a = coupling(float(res["frequency"]), float(res["damping_ratio"]), sig.dt,
+                    load_damping(model, r))
+    u = r * m * sig.a + sig.filt(fr)
+    zi = signal.lfilter_zi(b, a) * u[0]
+    return (1.0 - r) * m * sig.a + signal.lfilter(b, a, u, zi=zi)[0]
 
 
 def residual(model: Model, sig: Signals) -> np.ndarray:
@@ -433,10 +557,13 @@ def noise_floor(r: np.ndarray, sig: Signals) -> dict[str, float]:
     """Estimate the noise part of a residual from its spectrum.
 
     Trajectory-locked mismatch lives at the low frequencies of the motion, measurement
-    noise (current noise, quantisation) is broadband. The noise density is the median
-    periodogram level in the upper part of the pass band (0.5 to 0.9 of the cut-off),
-    assumed flat below and shaped by the filter. This gives the noise variance and
-    the equivalent number of independent samples ``n_eff`` (coloured, not white).
+    noise (current noise, quantisation) is broadband. The noise density is a low
+    quantile (30 %) of the Welch periodogram over 0.25 to 0.9 of the cut-off, corrected
+    for the quantile of the chi-square spread of the periodogram, assumed flat below and
+    shaped by the filter: narrow peaks of position-locked forces (a screw's ripple
+    crossed at the record's speeds) and harmonics of repeated laps do not raise it, as
+    they would a median or a mean. This gives the noise variance and the equivalent
+    number of independent samples ``n_eff`` (coloured, not white).
 
     Parameters
     ----------
@@ -450,6 +577,8 @@ def noise_floor(r: np.ndarray, sig: Signals) -> dict[str, float]:
     dict
         ``rms`` [N] (noise floor), ``n_eff``, ``bandwidth_hz`` (equivalent noise band).
     """
+    from scipy import stats
+
     y = r[sig.mask] - np.mean(r[sig.mask])
     n = y.size
     nper = int(min(n, max(256, 2 ** int(np.log2(max(n // 8, 256))))))
@@ -458,10 +587,14 @@ def noise_floor(r: np.ndarray, sig: Signals) -> dict[str, float]:
     sos = signal.butter(4, fc / (0.5 * sig.fs), output="sos")
     _, h = signal.sosfreqz(sos, worN=f, fs=sig.fs)
     h2 = np.abs(h) ** 4  # filtfilt: squared magnitude, squared again for power
-    band = (f >= 0.5 * fc) & (f <= 0.9 * fc)
-    if not np.any(band):  # pragma: no cover - tiny records
+    band = (f >= 0.25 * fc) & (f <= 0.9 * fc)
+    if np.sum(band) < 4:  # pragma: no cover - tiny records
         band = f > 0
-    level = float(np.median(p[band] / np.maximum(h2[band], 1e-12)))
+    segs = max(1, 2 * n // nper - 1)  # Hann, half overlap
+    dof = 2.0 * segs * 0.9
+    q = 0.3
+    level = float(np.quantile(p[band] / np.maximum(h2[band], 1e-12), q)
+                  / (stats.chi2.ppf(q, dof) / dof))
     df = f[1] - f[0]
     b_eq = float(np.sum(h2) * df)  # one-sided equivalent noise bandwidth [Hz]
     var = level * b_eq

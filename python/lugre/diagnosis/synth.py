@@ -42,8 +42,11 @@ def reference_trajectory(t: np.ndarray, seed: int = 0) -> np.ndarray:
     a = np.array([0.09, 0.04, 0.02])
     ph = rng.uniform(0, 2 * np.pi, 3)
     x = sum(ai * np.sin(2 * np.pi * fi * t + p) for ai, fi, p in zip(a, f, ph))
-    ramp = np.clip(t / 0.5, 0, 1)
-    return ramp * (x - x[0] * 0)
+    # a smooth start (continuous acceleration): a kink would step the PID's derivative
+    # term, a current step of several amperes that no drive reference has
+    u = np.clip(t / 1.0, 0.0, 1.0)
+    ramp = u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
+    return ramp * x
 
 
 def concealed(

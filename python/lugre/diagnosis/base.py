@@ -1,0 +1,157 @@
+"""Base parameters of the model (mass, LuGre levels, presliding) as regressors.
+
+The diagnosis re-estimates the friction levels of the model alongside every effect
+(their tolerance is a Gaussian prior: how far the parameters of a model that is "about
+right" may move). The mass is not among them: a changed mass is the ``mass`` effect
+(a payload), tested like any other. The presliding parameters ``sigma0`` and ``sigma1``
+are freed only when a record shows them (held-out profile test); otherwise they are held
+and reported as not determined by the record.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..model import Model
+from .residual import Signals, base_friction
+
+__all__ = ["BASE_PARAMS", "LEVELS", "PRESLIDING", "apply_base", "base_jacobian", "get_base",
+           "unit"]
+
+#: Every base parameter, and their tolerance (relative std of the
+#: prior: how far a parameter of a model that is "about right" may move).
+BASE_PARAMS: tuple[tuple[str, float], ...] = (
+    ("mass", 0.03),
+    ("positive.fc", 0.03),
+    ("positive.fs", 0.03),
+    ("positive.sigma2", 0.03),
+    ("positive.vs", 0.1),
+    ("negative.fc", 0.03),
+    ("negative.fs", 0.03),
+    ("negative.sigma2", 0.03),
+    ("negative.vs", 0.1),
+    ("sigma0", 0.3),
+    ("sigma1", 0.3),
+)
+
+#: Friction levels re-estimated alongside every effect.
+LEVELS: tuple[str, ...] = tuple(n for n, _ in BASE_PARAMS if "." in n)
+
+#: Presliding parameters, freed only when the record shows them.
+PRESLIDING: tuple[str, ...] = ("sigma0", "sigma1")
+
+
+def unit(name: str) -> str:
+    """SI unit of a base parameter."""
+    key = name.split(".")[-1]
+    return {"mass": "kg", "fc": "N", "fs": "N", "sigma2": "N s/m", "vs": "m/s",
+            "sigma0": "N/m", "sigma1": "N s/m"}[key]
+
+
+def get_base(model: Model, name: str) -> float:
+    """Value of a base parameter by its path (``mass``, ``positive.fc``, ``sigma0``)."""
+    if name == "mass":
+        return float(model.mass)
+    f = model.friction
+    if "." in name:
+        d, k = name.split(".")
+        return float(f[d][k])
+    return float(f[name])
+
+
+def apply_base(model: Model, values: dict[str, float]) -> Model:
+    """A copy of ``model`` with base parameters set (kept valid: ``fs >= fc`` etc.).
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    values : dict
+        New values by path.
+
+    Returns
+    -------
+    Model
+    """
+    d = model.to_dict()
+    f = d["friction"]
+    for name, val in values.items():
+        val = float(val)
+        if name == "mass":
+            d["axis"]["mass"] = max(val, 1e-6)
+        elif "." in name:
+            a, k = name.split(".")
+            f[a][k] = val
+        else:
+            f[name] = val
+    for side in ("positive", "negative"):
+        s = f[side]
+        s["fc"] = max(float(s["fc"]), 1e-9)
+        s["fs"] = max(float(s["fs"]), float(s["fc"]))
+        s["vs"] = max(float(s["vs"]), 1e-6)
+        s["sigma2"] = max(float(s["sigma2"]), 0.0)
+    f["sigma0"] = max(float(f["sigma0"]), 1.0)
+    f["sigma1"] = max(float(f["sigma1"]), 0.0)
+    return Model(d)
+
+
+def base_jacobian(model: Model, sig: Signals, fr0: np.ndarray | None = None,
+                  names: tuple[str, ...] | list[str] | None = None
+                  ) -> tuple[np.ndarray, list[str], np.ndarray, np.ndarray]:
+    """Jacobian of the filtered model force with respect to the base parameters.
+
+    Parameters
+    ----------
+    model : Model
+        The model at which to linearise (its effects included).
+    sig : Signals
+        The prepared recording.
+    fr0 : numpy.ndarray, optional
+        ``base_friction(model, sig)`` if already computed.
+    names : sequence of str, optional
+        The parameters to linearise in (default :data:`LEVELS`).
+
+    Returns
+    -------
+    J : numpy.ndarray
+        ``(n, q)``, filtered.
+    names : list of str
+        Parameter paths (identifiable ones only).
+    theta : numpy.ndarray
+        Current values.
+    tol : numpy.ndarray
+        Prior standard deviations (absolute).
+    """
+    if fr0 is None:
+        fr0 = base_friction(model, sig)
+    wanted = set(LEVELS if names is None else names)
+    cols: list[np.ndarray] = []
+    out: list[str] = []
+    theta: list[float] = []
+    tol: list[float] = []
+    for name, rel in BASE_PARAMS:
+        if name not in wanted:
+            continue
+        th = get_base(model, name)
+        if name == "mass":
+            col = sig.a.copy()
+            cols.append(col)
+        else:
+            side, key = (name.split(".") + [""])[:2] if "." in name else ("", name)
+            if key == "vs" and abs(model.friction[side]["fs"] - model.friction[side]["fc"]) < (
+                1e-3 * model.friction[side]["fc"]
+            ):
+                continue  # no Stribeck hump: vs does nothing
+            h = 1e-4 * max(abs(th), 1e-9)
+            if key == "fc":
+                h = -h  # keep fs >= fc
+            m2 = apply_base(model, {name: th + h})
+            col = (base_friction(m2, sig) - fr0) / h
+            if not np.any(np.abs(col) > 0):
+                continue
+            cols.append(sig.filt(col))
+        out.append(name)
+        theta.append(th)
+        tol.append(rel * max(abs(th), 1e-12))
+    J = np.column_stack(cols) if cols else np.zeros((len(sig), 0))
+    return J, out, np.array(theta), np.array(tol)

@@ -1,0 +1,438 @@
+"""Evidence in words: held-out gains, the offset against asymmetric levels, what a record
+determines of a drift, the motor force at rest, and the experiments that separate
+look-alikes."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..model import Model
+from . import base as B
+from . import residual as R
+from .search import Scorer, Term
+
+__all__ = ["EXPERIMENT", "drift_identifiability", "evidence", "offset_alternative",
+           "rest_evidence"]
+
+
+EXPERIMENT = {
+    ("delay", "current_lag"): (
+        "drive the axis at rest with a current step or a chirp up to a few hundred Hz and "
+        "compare force (or acceleration) and current: a pure delay shifts the phase "
+        "linearly with frequency at constant gain, a first-order lag attenuates the gain "
+        "by 3 dB at its bandwidth"
+    ),
+    ("offset", "asymmetry"): (
+        "hold the axis at rest under position control at several positions, approaching "
+        "each from both sides: a constant force shows as a steady holding current whose "
+        "mean over the two approaches is the offset, an asymmetric Coulomb level gives "
+        "holding currents that average to zero"
+    ),
+}
+
+#: Coulomb/static levels an offset shifts: +F forward, -F backward (the friction of the
+#: CONTRACT opposes the motion, the offset adds to the force the motor must give).
+_OFFSET_LEVELS = {"positive.fc": 1.0, "positive.fs": 1.0, "negative.fc": -1.0,
+                  "negative.fs": -1.0}
+
+
+def _moves(beta: np.ndarray, names: list[str], tol: np.ndarray) -> dict[str, float]:
+    """Base changes in units of their tolerance (prior standard deviation)."""
+    return {n: float(b / t) for n, b, t in zip(names, beta, tol)}
+
+
+def offset_alternative(scorer: Scorer, terms: list[Term], ev: Any, names: list[str],
+                        tol: np.ndarray, model: Model, sig: R.Signals, min_gain: float
+                        ) -> tuple[dict[str, Any] | None, str]:
+    """Weigh the offset against per-direction Coulomb/static levels (parsimony).
+
+    The same data are fitted once with the offset and once without it (the base
+    levels free); the held-out errors are compared, and the base moves of each story
+    are counted in units of their tolerance. Returns the alternative (when the two fit
+    about equally well on held-out data) and a sentence for the evidence.
+    """
+    k = next(j for j, t in enumerate(terms) if t.effect == "offset")
+    rest = [t for t in terms if t.effect != "offset"]
+    # the alternative at its best: Coulomb/static levels free (flat prior)
+    free_tol = np.array([t * (1e3 if n in _OFFSET_LEVELS else 1.0) for n, t in zip(names, tol)])
+    alt = Scorer(scorer.r, scorer.J, free_tol, scorer.mask, scorer.s2, scorer.K,
+                 center=scorer.center).evaluate(rest)
+    q = len(names)
+    m_off = _moves(ev.beta[:q], names, tol)
+    m_alt = _moves(alt.beta[:q], names, tol)
+    cost_off = float(sum(v * v for v in m_off.values()))
+    cost_alt = float(sum(v * v for v in m_alt.values()))
+    big_alt = {n: v for n, v in m_alt.items() if abs(v) >= 1.0}
+    big_off = {n: v for n, v in m_off.items() if abs(v) >= 1.0}
+    d_fit = float((alt.sse_b.sum() - ev.sse_b.sum()) / scorer.s2)
+    start = q + sum(t.X.shape[1] for t in terms[:k])
+    force = float(ev.beta[start])
+    levels = {n: B.get_base(model, n) + ev.beta[names.index(n)]
+              for n in _OFFSET_LEVELS if n in names}
+    alt_levels = {n: B.get_base(model, n) + alt.beta[names.index(n)]
+                  for n in _OFFSET_LEVELS if n in names}
+    alt_txt = ", ".join(f"{n} {v:.3g} N" for n, v in alt_levels.items())
+    verdict = ("fit the held-out blocks about as well" if d_fit <= 3.0 * min_gain else
+               f"fit the held-out blocks worse by {d_fit:.0f} (chi-square)")
+    txt = (f"Parsimony: one parameter (offset {force:.3g} N, {len(big_off)} base parameters "
+           f"moved by over one tolerance, sum of squared moves {cost_off:.0f}) against "
+           f"asymmetric Coulomb/static levels ({alt_txt}), which move {len(big_alt)} base "
+           f"parameters by over one tolerance (sum of squared moves {cost_alt:.0f}) and "
+           f"{verdict}.")
+    rest_txt = rest_evidence(sig)
+    if rest_txt:
+        txt += " " + rest_txt
+    if d_fit > 3.0 * min_gain:
+        return None, txt
+    return {
+        "effect": "asymmetric_friction",
+        "parameters": {**{n: float(v) for n, v in alt_levels.items()},
+                       "moves_in_tolerances": {n: round(v, 2) for n, v in big_alt.items()}},
+        "note": (f"Coulomb/static levels shifted by direction ({alt_txt}, against "
+                 f"{', '.join(f'{n} {v:.3g} N' for n, v in levels.items())} with the "
+                 "offset) fit the motion about as well but move more parameters"),
+        "experiment": EXPERIMENT[("offset", "asymmetry")],
+    }, txt
+
+
+def drift_identifiability(term: Term, T: float, thr: float = 10.0
+                           ) -> tuple[dict[str, Any], str]:
+    """What a record determines of a drift: intervals from the held-out profile over tau.
+
+    Over a record short against the time constant, gain and time constant trade off and
+    only the change over the record (a trend) is determined. The interval is the set of
+    time constants whose held-out score lies within ``thr`` of the best (the selection
+    threshold on the coloured chi-square scale, at the resolution of the grid); the time
+    constant counts as determined when that interval closes inside the record.
+    """
+    pr = term.profile
+    if pr is None:
+        return {}, ""
+    h, sc, beta = pr["h"], pr["score"], pr["beta"]
+    ok = sc <= sc.min() + thr
+    g = -beta[ok, 0]
+    taus = h[ok]
+    lo, hi = float(taus.min()), float(taus.max())
+    open_hi = hi >= 0.999 * pr["grid_max"]
+    open_lo = lo <= 1.001 * pr["grid_min"]
+    determined = not open_hi and not open_lo and hi <= T
+    rate = g / taus
+    total = g * (1.0 - np.exp(-T / taus))
+    unc = {"time_constant": [lo, None if open_hi else hi],
+           "gain": [float(g.min()), float(g.max())],
+           "initial_rate_per_s": [float(rate.min()), float(rate.max())],
+           "change_over_record": [float(total.min()), float(total.max())],
+           "mean_rate_per_s": [float(total.min() / T), float(total.max() / T)],
+           "time_constant_determined": bool(determined),
+           "criterion": f"held-out score within {thr:g} of the best"}
+    if not determined:
+        txt = (f"Over the {T:.3g} s record the Coulomb/static level falls by "
+               f"{100 * total.min():.2g} to {100 * total.max():.2g} % "
+               f"({100 * total.min() / T:.2g} to {100 * total.max() / T:.2g} %/s on average); "
+               f"the time constant is not determined (from {lo:.3g} s to "
+               f"{'beyond the grid' if open_hi else f'{hi:.3g} s'}: gain and time constant "
+               "trade off), the pair reported is the best on the grid.")
+    else:
+        txt = (f"Time constant {lo:.3g} to {hi:.3g} s and gain {g.min():.3g} to "
+               f"{g.max():.3g} fit within {thr:g} of the best held-out score; the level "
+               f"falls by {100 * total.min():.2g} to {100 * total.max():.2g} % over the "
+               "record.")
+    return unc, txt
+
+
+def rest_evidence(sig: R.Signals, min_s: float = 0.2) -> str:
+    """Mean motor force in stretches at rest (entered from either side), if any."""
+    still = (sig.v == 0.0) & sig.mask
+    n_min = int(min_s * sig.fs)
+    runs = []
+    k = 0
+    n = still.size
+    while k < n:
+        if still[k]:
+            j = k
+            while j < n and still[j]:
+                j += 1
+            if j - k >= n_min:
+                runs.append((k, j))
+            k = j
+        else:
+            k += 1
+    if not runs:
+        return ""
+    means = [float(np.mean(sig.fm_f[a:b])) for a, b in runs]
+    tot = sum(b - a for a, b in runs) / sig.fs
+    return (f"At rest ({len(runs)} stretches, {tot:.2g} s) the motor force averages "
+            f"{np.mean(means):.3g} N (friction can hold any force up to the static level "
+            "there, so this bounds rather than measures the offset).")
+
+
+def evidence(t: Term, log: dict[str, Any], K: int, extra: str = "") -> str:
+    """The evidence of a finding in two or three sentences a person can check."""
+    sig_txt = f"{t.cand.signature[0].upper()}{t.cand.signature[1:]}."
+    if log:
+        sig_txt += (f" Fitted with the friction levels on nine tenths of the record, it "
+                    f"predicts the tenth left out better in {log['positive']} of {K} such "
+                    f"stretches (chance of this from noise alone: p = {log['p']:.1g}).")
+    return sig_txt + (" " + extra if extra else "")
+
+
+def base_report(model: Model, base: dict[str, float], free: list[str],
+                presliding: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """Every base parameter before and after, its change, tolerance and status."""
+    out = {}
+    for n, rel in B.BASE_PARAMS:
+        b0 = B.get_base(model, n)
+        b1 = B.get_base(B.apply_base(model, base), n)
+        status = "refitted" if n in free else "held"
+        if n in B.PRESLIDING and n not in free:
+            status = "not determined by this record (held)"
+        out[n] = {"before": b0, "after": b1, "change": (b1 - b0) / b0 if b0 else 0.0,
+                  "tolerance": rel, "unit": B.unit(n), "status": status}
+    out["sigma1"]["presliding_test"] = {k: presliding[k] for k in
+                                        ("gain", "p", "positive", "free") if k in presliding}
+    return out
+
+
+def base_moves(base: dict[str, dict[str, Any]], factor: float = 2.0) -> list[dict[str, Any]]:
+    """Base parameters that moved by more than ``factor`` tolerances, in words."""
+    out = []
+    for n, b in base.items():
+        if abs(b["change"]) > factor * b["tolerance"]:
+            d = b["after"] - b["before"]
+            out.append({"parameter": n, "before": b["before"], "after": b["after"],
+                        "unit": b["unit"],
+                        "text": (f"{n} {d:+.3g} {b['unit']} ({100 * b['change']:+.0f} %, from "
+                                 f"{b['before']:.4g} to {b['after']:.4g} {b['unit']})")})
+    return out
+
+
+def base_notes(base: dict[str, dict[str, Any]], findings: list[Any]) -> list[str]:
+    """Notes on the base: large moves (a finding in words), presliding held, asymmetry."""
+    notes = []
+    moves = base_moves(base, factor=3.0)
+    if moves:
+        lv = [m for m in moves if m["parameter"].split(".")[-1] in ("fc", "fs")]
+        txt = ("The base moved beyond three tolerances: " + "; ".join(m["text"] for m in moves)
+               + ".")
+        if lv:
+            txt += (" A change of the Coulomb/static level this large means the model's "
+                    "friction is off (or something at low speed and at reversals stands in "
+                    "for it); the refitted values are in the augmented model.")
+        notes.append(txt)
+    s1 = base["sigma1"]
+    if "not determined" in s1["status"]:
+        pt = s1.get("presliding_test", {})
+        notes.append(
+            "sigma0 and sigma1 (presliding stiffness and damping) are held at the model's "
+            f"values: freeing them does not improve the held-out fit consistently (gains in "
+            f"{pt.get('positive', 0)} of 10 stretches, p = {pt.get('p', 1):.1g}), so this "
+            "record does not determine them. To determine them: small back-and-forth moves "
+            "below the breakaway force (presliding, a few micrometres) or a small-amplitude "
+            "current sweep at standstill, logged at 1 kHz or faster.")
+    bp, bn = base["positive.fc"]["after"], base["negative.fc"]["after"]
+    if not any(f.effect == "offset" for f in findings) and abs(bp - bn) > 0.1 * (bp + bn) / 2:
+        notes.append(
+            f"The Coulomb levels differ by direction ({bp:.3g} N forward, {bn:.3g} N "
+            f"backward); a constant force of {(bp - bn) / 2:.3g} N with a symmetric level "
+            f"would fit the motion equally well. To separate: "
+            f"{EXPERIMENT[('offset', 'asymmetry')]}.")
+    return notes
+
+
+def unexplained(r: np.ndarray, sig: R.Signals, floor: float, where: dict[str, Any],
+                after: dict[str, float]) -> dict[str, Any] | None:
+    """The rest above twice the noise floor: where it lives and what shape it has."""
+    from .locate import short_ranges
+
+    rms1 = after["rms_force"]
+    if rms1 <= 2.0 * floor:
+        return None
+    m = sig.mask
+    rr = r[m]
+    vf = sig.vf[m]
+    vmax = float(np.max(np.abs(vf)))
+    rev = np.zeros(vf.size, dtype=bool)
+    s = np.sign(np.where(np.abs(vf) > 0.02 * vmax, vf, 0.0))
+    nz = np.flatnonzero(s)
+    flips = nz[1:][s[nz[1:]] != s[nz[:-1]]]
+    w = max(int(0.05 * sig.fs), 3)
+    for j in flips:
+        rev[max(j - w, 0):j + w] = True
+    share_rev = float(np.sum(rr[rev] ** 2) / max(np.sum(rr ** 2), 1e-300))
+    shape = []
+    if rev.any() and share_rev > 2.0 * rev.mean() and share_rev > 0.3:
+        shape.append(
+            f"{100 * share_rev:.0f} % of the rest lies within 50 ms of the {flips.size} "
+            f"reversals ({100 * rev.mean():.0f} % of the time): a force step or lost motion "
+            "at each change of direction, e.g. backlash between motor and load, or a "
+            "presliding stage the model does not hold")
+    d = where.get("direction", {})
+    if d.get("positive") and d.get("negative"):
+        ratio = d["positive"] / d["negative"]
+        if ratio > 1.5 or ratio < 1 / 1.5:
+            shape.append(f"it is {'larger moving forward' if ratio > 1 else 'larger moving backward'}"
+                         f" ({d['positive']:.3g} N against {d['negative']:.3g} N rms)")
+    parts = [f"{k} {short_ranges(where[k])}" for k in ("time", "position", "velocity")
+             if where.get(k)]
+    msg = (f"after the findings the residual is still {rms1:.3g} N rms, {rms1 / floor:.1f} "
+           "times the noise floor, and no effect of the vocabulary explains the rest")
+    msg += "; it lives at " + "; ".join(parts) if parts else ""
+    msg += ". " + "; ".join(shape) + "." if shape else "."
+    return {"rms_force": rms1, "noise_floor": floor, "reversal_share": share_rev,
+            "where": {k: where.get(k) for k in ("time", "position", "velocity", "direction")},
+            "shape": shape, "message": msg[0].upper() + msg[1:]}
+
+
+def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str],
+                     min_gain: float) -> list[dict[str, Any]]:
+    """Per effect of the vocabulary not found: the smallest size this record would have
+    revealed, from the held-out scale of the search.
+
+    An effect of size ``b`` with column ``X`` (per unit size) lowers the held-out score by
+    about ``b^2*|X_perp|^2/s2`` (``X_perp``: what the friction levels cannot absorb);
+    the search needs about ``min_gain + 20`` to accept it consistently, so sizes under
+    ``sqrt((min_gain + 20)*s2/|X_perp|^2)`` pass unseen.
+    """
+    need = min_gain + 20.0
+    J = scorer.J[scorer.idx]
+    Q = np.linalg.qr(J)[0] if J.shape[1] else np.zeros((J.shape[0], 0))
+    sig = ctx.sig
+
+    def size(X: np.ndarray) -> float:
+        x = X[scorer.idx]
+        xp = x - Q @ (Q.T @ x)
+        e = float(xp @ xp)
+        return float(np.sqrt(need * scorer.s2 / e)) if e > 0 else float("inf")
+
+    out: list[dict[str, Any]] = []
+    span = ctx.xrange[1] - ctx.xrange[0]
+    for c in cands:
+        if c.effect in found:
+            continue
+        e = c.effect
+        try:
+            if e == "offset":
+                b = size(np.ones(len(sig)))
+                out.append(_hide(e, b, "N", f"a constant force under {b:.2g} N"))
+            elif e == "spring":
+                b = size(sig.x - np.mean(sig.x[sig.mask]))
+                out.append(_hide(e, b, "N/m", f"a spring under {b:.3g} N/m "
+                                 f"({b * span:.2g} N over the stroke)"))
+            elif e == "mass":
+                b = size(sig.a)
+                out.append(_hide(e, b, "kg", f"a payload under {b:.2g} kg"))
+            elif e == "drag":
+                b = size(sig.filt(np.abs(sig.v) * sig.v))
+                out.append(_hide(e, b, "N s^2/m^2", f"a drag under {b:.3g} N s^2/m^2"))
+            elif e == "cogging":
+                kmax = c.kmax(ctx)
+                ks = np.geomspace(1.5 / max(span, 1e-9), max(kmax, 2.0 / max(span, 1e-9)), 8)
+                amps = [size(sig.filt(np.sin(2 * np.pi * k * sig.x))) for k in ks]
+                b = float(np.max(amps))
+                txt = (f"a cogging under {b:.2g} N at pitches {1e3 / ks[-1]:.3g} to "
+                       f"{1e3 / ks[0]:.3g} mm; pitches under {1e3 / kmax:.3g} mm are faster "
+                       "than the filter band at this record's slowest motion (record slower "
+                       "feeds to see them)")
+                out.append(_hide(e, b, "N", txt, rng=[1 / ks[-1], 1 / ks[0]]))
+            elif e == "delay":
+                b = size(sig.dfm)
+                out.append(_hide("delay/current_lag", b, "s",
+                                 f"a delay or current lag under {b * 1e3:.2g} ms"))
+            elif e == "drift":
+                b = size((sig.t / max(sig.t[-1], 1e-9)) * ctx.fcs)
+                out.append(_hide(e, b, "-", f"a friction drift under {100 * b:.2g} % over the "
+                                 "record"))
+            elif e == "position_friction":
+                b = size(sig.filt(ctx.fcs * (np.abs(sig.x - np.mean(sig.x)) < 0.1 * span)))
+                out.append(_hide(e, b, "-", f"a friction change under {100 * b:.2g} % over a "
+                                 "tenth of the stroke"))
+            elif e in ("stribeck_shape", "deadband", "resonance"):
+                out.append(_nonlinear_hidden(c, ctx, size))
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError):  # pragma: no cover
+            continue
+    return [o for o in out if o is not None]
+
+
+def _hide(effect: str, b: float, unit: str, what: str, rng: Any = None,
+          experiment: str = "") -> dict[str, Any]:
+    return {"effect": effect, "smallest": b, "unit": unit, "range": rng,
+            "experiment": experiment,
+            "text": f"{what} would not be seen in this record" + (
+                f"; {experiment}" if experiment else "")}
+
+
+def _nonlinear_hidden(c: Any, ctx: Any, size: Any) -> dict[str, Any] | None:
+    sig = ctx.sig
+    if c.effect == "stribeck_shape":
+        X = c.columns(1.0, ctx)[:, 0]  # exponent 2 -> 1
+        b = size(X)
+        slow = float(np.mean(np.abs(sig.vf[sig.mask]) < 3 * min(ctx.model.positive["vs"],
+                                                                  ctx.model.negative["vs"])))
+        exp = ("steady slow feeds at 0.3 to 3 times the Stribeck velocity in both directions "
+               "would show it") if slow < 0.05 else ""
+        return _hide(c.effect, b, "-", f"a Stribeck exponent within {b:.2g} of 2",
+                     experiment=exp)
+    if c.effect == "deadband":
+        d0 = 0.02
+        b = d0 * size(c.columns(d0, ctx)[:, 0])
+        return _hide(c.effect, b, "A", f"a dead-band under {1e3 * b:.2g} mA")
+    if c.effect == "resonance":
+        g = c.grid(ctx)
+        if g is None:
+            return _hide(c.effect, float("inf"), "Hz", "a resonance",
+                         experiment="the filter band is too narrow; record faster")
+        fs = sorted({h[0] for h in g})
+        hidden = [f for f in fs if size(c.columns((f, 0.05, 0.5), ctx)[:, 0]) > 1.0]
+        if not hidden:
+            return None
+        return _hide(c.effect, 0.5, "load fraction",
+                     f"a resonance with half the mass on the coupling at {hidden[0]:.3g} to "
+                     f"{hidden[-1]:.3g} Hz", rng=[hidden[0], hidden[-1]],
+                     experiment=("the record's motion does not excite those frequencies; a "
+                                 "current chirp from 5 Hz to the drive's bandwidth at rest, or "
+                                 "fast reversals, would"))
+    return None
+
+
+def verdict(dg: Any) -> str:
+    """The verdict in one paragraph: what is wrong, how sure, what to do next."""
+    hb, ha = dg.fit.get("holdout_before"), dg.fit.get("holdout_after")
+    gain = ""
+    if hb and ha and hb.get("rms_force"):
+        gain = (f" On the held-out record the force error goes from {hb['rms_force']:.3g} to "
+                f"{ha['rms_force']:.3g} N rms ({100 * (ha['rms_force'] / hb['rms_force'] - 1):+.0f} %).")
+    if not dg.findings:
+        txt = "Nothing found: the model leaves nothing out that this record can show."
+        if dg.base_moves:
+            txt = ("No missing physics found, but the model's base parameters are off: "
+                   + "; ".join(m["text"] for m in dg.base_moves) + ".")
+        if dg.unexplained:
+            txt = ("Unexplained: the model misses this record, but no effect of the "
+                   "vocabulary accounts for it. " + dg.unexplained["message"])
+        return txt + gain
+    names = ", ".join(f"{f.effect} ({_params(f)})" for f in dg.findings)
+    txt = f"Found: {names}.{gain} Add them to the model (the augmented model has them)."
+    if any(f.alternatives for f in dg.findings):
+        txt += " Some have a look-alike this record cannot rule out: see each finding."
+    if dg.unexplained:
+        txt += " A rest stays unexplained: " + dg.unexplained["message"]
+    return txt
+
+
+def _params(f: Any) -> str:
+    units = {"amplitude": "N", "pitch": "m", "phase": "rad", "stiffness": "N/m", "x0": "m",
+             "force": "N", "delta": "kg", "seconds": "s", "bandwidth": "Hz",
+             "gain": "", "time_constant": "s", "frequency": "Hz", "damping_ratio": "",
+             "load_fraction": "", "current": "A", "coefficient": "N s^2/m^2",
+             "exponent": ""}
+    parts = []
+    for k, v in f.parameters.items():
+        if isinstance(v, (int, float)):
+            parts.append(f"{k} {v:.3g}{' ' + units.get(k, '') if units.get(k) else ''}")
+    if f.effect == "position_friction":
+        sc = np.asarray(f.parameters["scale"])
+        j = int(np.argmax(np.abs(sc - 1)))
+        parts.append(f"level x{sc[j]:.3g} at x = {f.parameters['positions'][j]:.3g} m")
+    return ", ".join(parts)

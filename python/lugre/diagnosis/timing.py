@@ -1,0 +1,74 @@
+"""Timing of the motor force against the recorded current: a pure delay or a first-order
+lag (current loop, inductance).
+
+Both have the same first-order signature (the force follows the command by an effective
+delay ``tau``); they are told apart by their exact forms, each refitted jointly with the
+base: a delay shifts the phase linearly with frequency at constant gain, a lag also
+attenuates. The lag is discretised for a command interpolated linearly between samples
+(its mean delay is then exactly ``1/(2*pi*bandwidth)``), so that the two forms name the
+same delay and the choice between them rests on their shapes alone.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..model import Model
+from . import effects as E
+from . import residual as R
+from .evidence import EXPERIMENT
+from .refit import refine
+from .search import Term
+
+__all__ = ["choose_timing", "effective_delay"]
+
+
+def effective_delay(effect: dict[str, Any]) -> float:
+    """Mean delay [s] of the force behind the recorded current for a timing effect."""
+    if effect["effect"] == "delay":
+        return float(effect["seconds"])
+    return 1.0 / (2.0 * math.pi * float(effect["bandwidth"]))
+
+
+def choose_timing(model: Model, sig: R.Signals, terms: list[Term], k: int,
+                  base: dict[str, float], betas: list[np.ndarray], s2: float,
+                  names: list[str], blocks: list[slice], min_gain: float
+                  ) -> tuple[Model, dict[str, float], list[np.ndarray], E.Context, list[Term],
+                             dict[str, Any] | None]:
+    """Refit with the timing term as a delay and as a current lag; keep the better.
+
+    Returns the refit of the better form and, when the held-out blocks do not separate
+    the two (t < 3 or a total difference under ``min_gain``), the delay (what the record
+    shows: a time shift) with the lag as an alternative and the experiment that
+    separates them.
+    """
+    fits = {}
+    for form in ("delay", "current_lag"):
+        tt = list(terms)
+        tt[k] = Term(cand=terms[k].cand, h=form, X=terms[k].X)
+        out = refine(model, sig, tt, dict(base), [b.copy() for b in betas], s2, names)
+        fits[form] = (*out, R.residual(out[0], sig))
+    sse = {f: np.array([np.sum(v[5][sig.mask][b] ** 2) for b in blocks])
+           for f, v in fits.items()}
+    dd = (sse["delay"] - sse["current_lag"]) / s2
+    tstat = abs(dd.mean()) / (dd.std(ddof=1) / math.sqrt(dd.size) + 1e-300)
+    separated = tstat >= 3.0 and abs(dd.sum()) >= min_gain
+    # not separated: the record shows a time shift and nothing of the attenuation a lag
+    # would add, so the pure delay is named and the lag given beside it
+    better = "current_lag" if separated and dd.sum() > 0 else "delay"
+    other = "delay" if better == "current_lag" else "current_lag"
+    aug, base_f, betas_f, ctx, terms_f, _ = fits[better]
+    alt = None
+    if not separated:
+        ao = fits[other]
+        eff = ao[4][k].cand.to_effects(other, ao[2][k], ao[3])[0]
+        alt = {"effect": other,
+               "parameters": {a: v for a, v in eff.items() if a != "effect"},
+               "effective_delay_s": effective_delay(eff),
+               "note": (f"fits the held-out blocks about as well (difference "
+                        f"{abs(dd.sum()):.0f} in squared-error units of the noise)"),
+               "experiment": EXPERIMENT[("delay", "current_lag")]}
+    return aug, base_f, betas_f, ctx, terms_f, alt
