@@ -17,7 +17,7 @@ from .._native import simulate
 from ..io import Recording
 from ..model import Model
 
-__all__ = ["EFFECTS", "concealed", "reference_trajectory"]
+__all__ = ["EFFECTS", "axis_model", "case", "concealed", "reference_trajectory", "trajectory"]
 
 #: A default concealed instance of every effect of the vocabulary.
 EFFECTS: dict[str, dict[str, Any] | None] = {
@@ -124,3 +124,102 @@ def concealed(
         f[side]["fs"] = max(f[side]["fs"], f[side]["fc"])
     b["axis"]["mass"] *= 1 + base_error * rng.standard_normal()
     return rec, Model(b), truth
+
+
+def axis_model(seed: int) -> Model:
+    """A random axis: mass 6-90 kg, force constant 10-60 N/A, Coulomb friction 2-8 % of
+    the weight-like scale ``10*mass``, static 1.3-2.2x Coulomb, a PID at 5-10 kHz tuned
+    to the mass (same bandwidth as the paper axis)."""
+    rng = np.random.default_rng(seed + 7000)
+    m = float(np.exp(rng.uniform(np.log(6.0), np.log(90.0))))
+    kf = float(rng.uniform(10.0, 60.0))
+    fc = 10.0 * m * rng.uniform(0.02, 0.08)
+    sets = {}
+    for side in ("positive", "negative"):
+        f = fc * (1 + 0.05 * rng.standard_normal())
+        sets[side] = {"fc": f, "fs": f * rng.uniform(1.3, 2.2),
+                      "sigma2": m * rng.uniform(4.0, 16.0),
+                      "vs": float(np.exp(rng.uniform(np.log(0.003), np.log(0.02))))}
+    s0 = 3.0 * max(sets["positive"]["fs"], sets["negative"]["fs"]) / 1e-3 * rng.uniform(0.5, 2)
+    g = m / 25.0
+    rate = float(rng.choice([5000.0, 10000.0]))
+    return Model({
+        "axis": {"mass": m, "force_constant": kf},
+        "friction": {"model": "lugre", "sigma0": s0, "sigma1": 0.3 * np.sqrt(s0 * m) * 0.05,
+                     **sets},
+        "effects": [],
+        "controller": {"type": "pid", "kp": 5e4 * g, "ki": 5e5 * g, "kd": 1500.0 * g,
+                       "rate_hz": rate},
+    })
+
+
+def trajectory(kind: str, t: np.ndarray, seed: int = 0, stroke: float = 0.15) -> np.ndarray:
+    """A position reference [m]: ``"sines"`` (smooth back and forth), ``"p2p"``
+    (point-to-point moves with dwells, S-curve profiles) or ``"feeds"`` (constant-speed
+    passes at several speeds, slow ones included, both ways)."""
+    if kind == "sines":
+        return reference_trajectory(t, seed) * (stroke / 0.15)
+    rng = np.random.default_rng(seed + 3000)
+    x = np.zeros_like(t)
+    if kind == "p2p":
+        tk, pos = 1.0, 0.0
+        while tk < t[-1]:
+            target = float(rng.uniform(-stroke, stroke))
+            dur = float(rng.uniform(0.4, 1.5))
+            u = np.clip((t - tk) / dur, 0, 1)
+            sm = u * u * u * (10 - 15 * u + 6 * u * u)
+            x = np.where(t >= tk, pos + (target - pos) * sm, x)
+            pos = target
+            tk += dur + float(rng.uniform(0.1, 0.6))
+        return x
+    if kind == "feeds":
+        speeds = np.array([0.003, 0.01, 0.03, 0.1, 0.2]) * (stroke / 0.15)
+        rng.shuffle(speeds)
+        v = np.zeros_like(t)
+        seg = (t[-1] - 1.0) / (2 * speeds.size)
+        for j, sp in enumerate(np.repeat(speeds, 2)):
+            a, b = 1.0 + j * seg, 1.0 + (j + 1) * seg
+            sgn = 1.0 if j % 2 == 0 else -1.0
+            u = np.clip((t - a) / (b - a), 0, 1)
+            v += sgn * sp * np.sin(np.pi * u) ** 0.2 * ((t >= a) & (t < b))
+        x = np.cumsum(v) * (t[1] - t[0])
+        u = np.clip(t / 1.0, 0.0, 1.0)
+        return x * u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
+    raise ValueError(f"unknown trajectory {kind!r}")
+
+
+def case(truth_effects: list[dict[str, Any]], *, seed: int, axis_seed: int | None = None,
+         kind: str = "sines", duration: float = 20.0, rate_hz: float = 1000.0,
+         current_noise: float = 0.01, quantum: float = 1e-6, base_error: float = 0.01
+         ) -> tuple[Recording, Recording, Model, Model]:
+    """A concealed case: recording and hold-out (another seed of the same trajectory
+    kind), the believed model (base off by ``base_error``) and the truth.
+
+    ``axis_seed`` None: the paper axis; else :func:`axis_model`.
+    """
+    truth = (Model.paper().replace(controller={"type": "pid", "kp": 5e4, "ki": 5e5,
+                                               "kd": 1500.0, "rate_hz": 10000.0})
+             if axis_seed is None else axis_model(axis_seed))
+    truth = truth.replace(effects=[dict(e) for e in truth_effects])
+    recs = []
+    for s in (seed, seed + 1):
+        rng = np.random.default_rng(s + 1000)
+        rate = float(truth.controller["rate_hz"])
+        over = max(1, round(rate / rate_hz))
+        n = int(duration * rate_hz)
+        tf = np.arange(n * over) / (rate_hz * over)
+        stroke = 0.15 if axis_seed is None else float(rng.uniform(0.05, 0.3))
+        sf = simulate(truth, tf, trajectory(kind, tf, s, stroke))
+        t = tf[::over]
+        i = sf.i[::over] + current_noise * rng.standard_normal(t.size)
+        x = np.round(sf.x[::over] / quantum) * quantum
+        recs.append(Recording(t=t, x=x, i=i, x_ref=trajectory(kind, t, s, stroke)))
+    rng = np.random.default_rng(seed + 2000)
+    b = truth.to_dict()
+    b["effects"] = []
+    f = b["friction"]
+    for side in ("positive", "negative"):
+        for k in ("fc", "fs", "sigma2", "vs"):
+            f[side][k] *= 1 + base_error * rng.standard_normal()
+        f[side]["fs"] = max(f[side]["fs"], f[side]["fc"])
+    return recs[0], recs[1], Model(b), truth
