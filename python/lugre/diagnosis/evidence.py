@@ -315,7 +315,10 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
         try:
             if e == "offset":
                 b = size(np.ones(len(sig)))
-                out.append(_hide(e, b, "N", f"a constant force under {b:.2g} N"))
+                out.append(_hide(e, b, "N", f"a constant force under {b:.2g} N", experiment=(
+                    "per-direction friction levels absorb a constant force while the axis "
+                    "moves; " + EXPERIMENT[("offset", "asymmetry")].split(":")[0]
+                    + " separates them")))
             elif e == "spring":
                 b = size(sig.x - np.mean(sig.x[sig.mask]))
                 out.append(_hide(e, b, "N/m", f"a spring under {b:.3g} N/m "
@@ -357,27 +360,41 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
 
 def _hide(effect: str, b: float, unit: str, what: str, rng: Any = None,
           experiment: str = "") -> dict[str, Any]:
-    return {"effect": effect, "smallest": b, "unit": unit, "range": rng,
-            "experiment": experiment,
-            "text": f"{what} would not be seen in this record" + (
-                f"; {experiment}" if experiment else "")}
+    verb = "would not be seen in" if np.isfinite(b) else "cannot be seen in"
+    return {"effect": effect, "smallest": b if np.isfinite(b) else None, "unit": unit,
+            "range": rng, "experiment": experiment,
+            "text": f"{what} {verb} this record" + (f"; {experiment}" if experiment else "")}
+
+
+def _amps(a: float) -> str:
+    return f"{a * 1e3:.3g} mA" if abs(a) < 1 else f"{a:.3g} A"
 
 
 def _nonlinear_hidden(c: Any, ctx: Any, size: Any) -> dict[str, Any] | None:
     sig = ctx.sig
     if c.effect == "stribeck_shape":
-        X = c.columns(1.0, ctx)[:, 0]  # exponent 2 -> 1
-        b = size(X)
-        slow = float(np.mean(np.abs(sig.vf[sig.mask]) < 3 * min(ctx.model.positive["vs"],
-                                                                  ctx.model.negative["vs"])))
+        m = ctx.model
+        hump = min(m.positive["fs"] / m.positive["fc"], m.negative["fs"] / m.negative["fc"])
+        slow = float(np.mean(np.abs(sig.vf[sig.mask]) < 3 * min(m.positive["vs"],
+                                                                  m.negative["vs"])))
         exp = ("steady slow feeds at 0.3 to 3 times the Stribeck velocity in both directions "
-               "would show it") if slow < 0.05 else ""
+               "would show it")
+        if hump < 1.02:
+            return _hide(c.effect, float("inf"), "-", "the shape of the Stribeck curve (the "
+                         "model has no static level above the Coulomb level, fs = fc)",
+                         experiment=exp)
+        b = size(c.columns(1.0, ctx)[:, 0])  # exponent 2 -> 1
+        if not np.isfinite(b) or b > 5:
+            return _hide(c.effect, float("inf"), "-", "the shape of the Stribeck curve",
+                         experiment=exp)
         return _hide(c.effect, b, "-", f"a Stribeck exponent within {b:.2g} of 2",
-                     experiment=exp)
+                     experiment=exp if slow < 0.05 else "")
     if c.effect == "deadband":
         d0 = 0.02
         b = d0 * size(c.columns(d0, ctx)[:, 0])
-        return _hide(c.effect, b, "A", f"a dead-band under {1e3 * b:.2g} mA")
+        kf = ctx.model.force_constant
+        return _hide(c.effect, b, "A", f"a dead-band under {_amps(b)} ({b * kf:.2g} N of motor "
+                     "force)")
     if c.effect == "resonance":
         g = c.grid(ctx)
         if g is None:

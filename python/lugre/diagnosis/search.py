@@ -96,10 +96,29 @@ class Scorer:
         self.s2 = float(sigma_eff2)
         self.K = int(blocks)
         idx = np.flatnonzero(mask)
+        nb = idx.size // self.K  # equal blocks (the last few samples are left out)
+        idx = idx[:nb * self.K]
         self.idx = idx
-        edges = np.linspace(0, idx.size, self.K + 1).astype(int)
+        self._nb = nb
+        edges = np.arange(self.K + 1) * nb
         self.blocks = [slice(edges[k], edges[k + 1]) for k in range(self.K)]
         self.center = np.zeros(J.shape[1]) if center is None else np.asarray(center, float)
+        # per-block products of the base columns and the residual, once: an evaluation
+        # adds only its own columns' products (the search runs hundreds of them)
+        self._Jm = self._stack(J[idx])
+        self._rm = self._stack(r[idx][:, None])
+        self._GJJ = self._gram(self._Jm, self._Jm)
+        self._hJ = self._gram(self._Jm, self._rm)[:, :, 0]
+        self._rr = self._gram(self._rm, self._rm)[:, 0, 0]
+
+    def _stack(self, a: np.ndarray) -> np.ndarray:
+        """``(n, c)`` samples as ``(K, n/K, c)`` blocks."""
+        return a.reshape(self.K, self._nb, a.shape[1])
+
+    @staticmethod
+    def _gram(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Per-block ``a.T @ b``."""
+        return np.matmul(a.transpose(0, 2, 1), b)
 
     def evaluate(self, terms: list[Term]) -> Evaluation:
         """Fit base plus ``terms`` on all blocks and on each leave-one-block-out set.
@@ -114,30 +133,40 @@ class Scorer:
         Evaluation
         """
         q = self.J.shape[1]
-        cols = [self.J] + [t.X for t in terms]
-        D = np.column_stack(cols)
+        X = (np.column_stack([t.X for t in terms]) if terms
+             else np.zeros((self.J.shape[0], 0)))
         tols = [self.tol]
         for t in terms:  # effect priors (absolute, in coefficient units); None: flat
             tols.append(np.full(t.X.shape[1], np.inf) if t.prior is None else t.prior)
         ptol = np.concatenate(tols)
-        Dm = D[self.idx]
-        rm = self.r[self.idx]
-        sc = np.sqrt(np.mean(Dm * Dm, axis=0))
+        p = X.shape[1]
+        # per-block Gram matrices, raw, then scaled by the columns' rms
+        G_b = np.empty((self.K, q + p, q + p))
+        G_b[:, :q, :q] = self._GJJ
+        h_b = np.empty((self.K, q + p))
+        h_b[:, :q] = self._hJ
+        if p:
+            Xm = self._stack(X[self.idx])
+            GXJ = self._gram(Xm, self._Jm)
+            G_b[:, q:, :q] = GXJ
+            G_b[:, :q, q:] = GXJ.transpose(0, 2, 1)
+            G_b[:, q:, q:] = self._gram(Xm, Xm)
+            h_b[:, q:] = self._gram(Xm, self._rm)[:, :, 0]
+        rr_b = self._rr
+        diag = np.einsum("kii->i", G_b)
+        sc = np.sqrt(diag / self.idx.size)
         sc[sc == 0] = 1.0
-        Dn = Dm / sc
+        G_b = G_b / np.outer(sc, sc)
+        h_b = h_b / sc
         prec = np.where(np.isfinite(ptol), 1.0 / (sc * ptol) ** 2, 0.0)
-        cen = np.zeros(D.shape[1])
+        cen = np.zeros(q + p)
         cen[:q] = self.center * sc[:q]
         j = q
         for t in terms:
-            p = t.X.shape[1]
+            pt = t.X.shape[1]
             if t.center is not None:
-                cen[j:j + p] = np.asarray(t.center, float) * sc[j:j + p]
-            j += p
-        # einsum, not BLAS: small products, and no thread oversubscription on busy hosts
-        G_b = np.stack([np.einsum("ij,ik->jk", Dn[b], Dn[b]) for b in self.blocks])
-        h_b = np.stack([np.einsum("ij,i->j", Dn[b], rm[b]) for b in self.blocks])
-        rr_b = np.array([rm[b] @ rm[b] for b in self.blocks])
+                cen[j:j + pt] = np.asarray(t.center, float) * sc[j:j + pt]
+            j += pt
         G, h, rr = G_b.sum(0), h_b.sum(0), rr_b.sum()
         lam = self.s2 * prec
         eps = 1e-10 * np.trace(G) / G.shape[0]
@@ -159,7 +188,7 @@ class Scorer:
             sse_b[k] = rr_b[k] - 2 * bk @ h_b[k] + bk @ G_b[k] @ bk
             jack[k] = bk / sc
         beta = b / sc
-        fitted = np.einsum("ij,j->i", D, beta)
+        fitted = self.J @ beta[:q] + (X @ beta[q:] if p else 0.0)
         score = float(sse_b.sum() / self.s2 + prior)
         return Evaluation(score=score, sse_b=sse_b, prior=prior, beta=beta, fitted=fitted,
                           resid=self.r - fitted, sse=sse, splits=self.blocks, jack=jack)
