@@ -11,10 +11,10 @@ show the fit improve.
 from __future__ import annotations
 
 from .core import diagnose, evaluate
-from .inverse import fit_inverse_dynamics
+from .inverse import fit_inverse_dynamics, fit_model
 from .locate import locate
 from .plots import write_plots
 from .report import Diagnosis, Finding
 
-__all__ = ["Diagnosis", "Finding", "diagnose", "evaluate", "fit_inverse_dynamics", "locate",
+__all__ = ["Diagnosis", "Finding", "diagnose", "evaluate", "fit_inverse_dynamics", "fit_model", "locate",
            "write_plots"]

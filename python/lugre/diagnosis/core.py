@@ -113,6 +113,7 @@ def diagnose(
     candidates: list[str] | None = None,
     screw_lead: float | None = None,
     free_mass: bool = False,
+    tolerance: float = 1.0,
 ) -> Diagnosis:
     """Find the physics a model leaves out of a recording.
 
@@ -143,6 +144,10 @@ def diagnose(
     free_mass : bool, default False
         Re-estimate the mass as a base parameter (model identification) instead of
         testing a ``mass`` effect (a payload).
+    tolerance : float, default 1.0
+        Scale of the base parameters' tolerances (the prior on how far they may move
+        from the model): 1 diagnoses a model believed about right; identification from
+        a rough start uses a wide one.
 
     Returns
     -------
@@ -171,6 +176,7 @@ def diagnose(
     #    shows it (held-out profile test); the mass as a base parameter only when asked
     wanted = B.LEVELS + B.PRESLIDING + (("mass",) if free_mass else ())
     J, names, _, tol = B.base_jacobian(model, sig, fr0, names=wanted)
+    tol = tol * float(tolerance)
     held = [k for k, n in enumerate(names) if n not in B.PRESLIDING]
     noise = R.noise_floor(r0, sig)
     s2 = noise["rms"] ** 2 * n_used / noise["n_eff"]
@@ -213,12 +219,14 @@ def diagnose(
         from .timing import choose_timing
 
         aug, base, betas, ctx, terms, alt = choose_timing(
-            model, sig, terms, lag_k, base0, betas, s2, names, scorer.blocks, min_gain)
+            model, sig, terms, lag_k, base0, betas, s2, names, scorer.blocks, min_gain,
+            tolerance)
         if alt is not None:
             alternatives[lag_k] = [alt]
     else:
         aug, base, betas, ctx, terms = refine(model, sig, terms, dict(base0), betas, s2,
-                                              names, iters=3 if terms else 2)
+                                              names, iters=3 if terms else 2,
+                                              tolerance=tolerance)
         # a term whose share collapses in the joint refit (rms contribution under 0.2 of
         # the noise floor) is not a finding: drop it and refit the rest
         small = [k for k, t in enumerate(terms)
@@ -235,7 +243,7 @@ def diagnose(
             keep = [k for k in range(len(terms)) if k not in small]
             aug, base, betas, ctx, terms = refine(
                 model, sig, [terms[k] for k in keep], dict(base0), [betas[k] for k in keep],
-                s2, names, iters=3 if keep else 2)
+                s2, names, iters=3 if keep else 2, tolerance=tolerance)
 
     # 5. evidence and report
     r1 = R.residual(aug, sig)

@@ -13,7 +13,11 @@ from ..model import Model
 from . import residual as R
 from .core import as_recording
 
-__all__ = ["fit_inverse_dynamics"]
+__all__ = ["IDENTIFY_TOLERANCE", "fit_inverse_dynamics", "fit_model"]
+
+#: Scale of the base tolerances when identifying from the rough inverse-dynamics start
+#: (friction levels may move by about a third, not by 3 %).
+IDENTIFY_TOLERANCE = 10.0
 
 
 def fit_inverse_dynamics(
@@ -129,3 +133,65 @@ def fit_inverse_dynamics(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return Model(doc)
+
+
+def fit_model(
+    recording: Any,
+    *,
+    effects: list[str] | None = None,
+    mass: float | None = None,
+    force_constant: float = 1.0,
+    cutoff_hz: float | None = None,
+    screw_lead: float | None = None,
+) -> tuple[Model, Any]:
+    """Identify an axis model from a recording, with extra physics from the start.
+
+    The base (mass and per-direction LuGre friction) by robust inverse dynamics
+    (:func:`fit_inverse_dynamics`), then every base parameter refined with the bristle
+    state simulated along the measured velocity, jointly with the effects named in
+    ``effects`` (names of the CONTRACT vocabulary). An effect the record does not
+    support is left out and said so in the returned diagnosis (its trials and notes).
+
+    Parameters
+    ----------
+    recording : Recording or path
+        With motion in both directions.
+    effects : list of str, optional
+        Effects to identify with the base (e.g. ``["resonance", "drag"]``); default none.
+    mass : float, optional
+        Known moving mass [kg]; estimated otherwise.
+    force_constant : float, default 1.0
+        K_F [N/A] (needed when the recording holds the current).
+    cutoff_hz : float, optional
+        Low-pass cut-off (default ``fs/25``).
+    screw_lead : float, optional
+        Ball-screw lead [m] (tried for cogging).
+
+    Returns
+    -------
+    model : Model
+        The identified model (base and the effects the record supports).
+    diagnosis : Diagnosis
+        The refit, with the effects' evidence and what the record leaves open.
+    """
+    from ..exceptions import InputError
+    from .core import diagnose
+    from .effects import candidates
+
+    known = {c.effect for c in candidates()} | {"current_lag"}
+    wanted = list(effects or [])
+    for e in wanted:
+        if e not in known:
+            raise InputError.at("effects", f'unknown effect "{e}": use some of '
+                                f'{", ".join(sorted(known))}')
+    if "current_lag" in wanted and "delay" not in wanted:
+        wanted.append("delay")  # one timing candidate; its form is chosen by the record
+    rec = as_recording(recording)
+    base = fit_inverse_dynamics(rec, mass=mass, force_constant=force_constant,
+                                cutoff_hz=cutoff_hz)
+    dg = diagnose(rec, base, candidates=wanted, free_mass=mass is None, cutoff_hz=cutoff_hz,
+                  screw_lead=screw_lead, closed_loop=False, tolerance=IDENTIFY_TOLERANCE)
+    model = dg.augmented_model()
+    if mass is not None:
+        model = model.replace(axis={**model.axis, "mass": float(mass)})
+    return model, dg

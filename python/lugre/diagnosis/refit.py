@@ -36,7 +36,7 @@ def split(beta: np.ndarray, q: int, terms: list[Term]) -> tuple[np.ndarray, list
 
 def refine(model: Model, sig: R.Signals, terms: list[Term], base: dict[str, float],
            betas: list[np.ndarray], s2: float, names: tuple[str, ...] | list[str],
-           iters: int = 3
+           iters: int = 3, tolerance: float = 1.0
            ) -> tuple[Model, dict[str, float], list[np.ndarray], E.Context, list[Term]]:
     """Damped Gauss-Newton on base parameters and effect coefficients (exact residual).
 
@@ -60,6 +60,8 @@ def refine(model: Model, sig: R.Signals, terms: list[Term], base: dict[str, floa
         The base parameters that are free (the others are held at the model's values).
     iters : int, default 3
         Gauss-Newton steps at most.
+    tolerance : float, default 1.0
+        Scale of the base parameters' prior tolerances.
 
     Returns
     -------
@@ -101,10 +103,13 @@ def refine(model: Model, sig: R.Signals, terms: list[Term], base: dict[str, floa
         r = R.residual(aug, sig)
         return float(np.sum(r[sig.mask] ** 2)), aug, base, betas, ctx, r, terms
 
-    sse, aug, base, betas, ctx, r, terms = build(base, betas, terms)
+    # start from the linearised step of the selection, or from the model as given if
+    # that is better (a step far outside the linear range can make things worse)
+    sse, aug, base, betas, ctx, r, terms = min(
+        build(base, betas, terms), build(theta0, betas, terms), key=lambda o: o[0])
     for _ in range(iters):
         J, free, _, _ = B.base_jacobian(aug, sig, names=names)
-        tol = np.array([tolrel[n] * max(abs(theta0[n]), 1e-12) for n in free])
+        tol = np.array([tolerance * tolrel[n] * max(abs(theta0[n]), 1e-12) for n in free])
         center = np.array([theta0[n] - base[n] for n in free])
         cur_terms = [Term(cand=t.cand, h=t.h, X=t.cand.columns(t.h, ctx), prior=t.prior,
                           center=t.center) for t in terms]

@@ -35,7 +35,8 @@ def effective_delay(effect: dict[str, Any]) -> float:
 
 def choose_timing(model: Model, sig: R.Signals, terms: list[Term], k: int,
                   base: dict[str, float], betas: list[np.ndarray], s2: float,
-                  names: list[str], blocks: list[slice], min_gain: float
+                  names: list[str], blocks: list[slice], min_gain: float,
+                  tolerance: float = 1.0
                   ) -> tuple[Model, dict[str, float], list[np.ndarray], E.Context, list[Term],
                              dict[str, Any] | None]:
     """Refit with the timing term as a delay and as a current lag; keep the better.
@@ -49,7 +50,8 @@ def choose_timing(model: Model, sig: R.Signals, terms: list[Term], k: int,
     for form in ("delay", "current_lag"):
         tt = list(terms)
         tt[k] = Term(cand=terms[k].cand, h=form, X=terms[k].X)
-        out = refine(model, sig, tt, dict(base), [b.copy() for b in betas], s2, names)
+        out = refine(model, sig, tt, dict(base), [b.copy() for b in betas], s2, names,
+                     tolerance=tolerance)
         fits[form] = (*out, R.residual(out[0], sig))
     sse = {f: np.array([np.sum(v[5][sig.mask][b] ** 2) for b in blocks])
            for f, v in fits.items()}
