@@ -445,6 +445,26 @@ mod tests {
     }
 
     #[test]
+    fn general_kernel_reduces_to_the_plain_one() {
+        let p = paper();
+        let v: [f64; 6] = [0.0, 1e-3, 0.02, -0.004, -0.3, 0.1];
+        let (mut a, mut b) = ([0.0; 6], [0.0; 6]);
+        friction_force_into(&p, &v, 1e-3, 1e-5, &mut a, None);
+        friction_force_general_into(&p, &v, &[1e-3], 1e-5, None, None, &mut b, None);
+        assert_eq!(a, b);
+        // exponent 2 is the usual curve; scale multiplies g
+        let ones = [1.0; 6];
+        friction_force_general_into(&p, &v, &[1e-3], 1e-5, Some(&ones), Some(2.0), &mut b, None);
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() <= 1e-12 * x.abs().max(1.0));
+        }
+        let s = p.positive;
+        assert!((s.g_shaped(0.01, 1.0) - (s.fc + (s.fs - s.fc) * (-1.0f64).exp())).abs() < 1e-12);
+        let (g, _, _) = p.eval(0.0, 0.02, 1.5);
+        assert!((g - 1.5 * s.g(0.02)).abs() < 1e-12);
+    }
+
+    #[test]
     fn f32_works() {
         let s = StaticSet::<f32>::new(28.7, 60.2, 332.5, 0.01).unwrap();
         let p = LugreParams::<f32>::new(1e5, 31.62, s, s).unwrap();

@@ -709,4 +709,61 @@ mod tests {
             "{e}"
         );
     }
+
+    fn with_effects(effects: &str) -> Result<Model> {
+        Model::from_json(&PAPER.replace("\"effects\": []", &format!("\"effects\": [{effects}]")))
+    }
+
+    #[test]
+    fn new_effects_parse_and_validate() {
+        let m = with_effects(
+            r#"{"effect": "resonance", "frequency": 22, "damping_ratio": 0.04, "load_fraction": 0.75},
+               {"effect": "deadband", "current": 0.15}, {"effect": "drag", "coefficient": 120},
+               {"effect": "stribeck_shape", "exponent": 0.8}"#,
+        )
+        .unwrap();
+        assert_eq!(
+            m.effects[0],
+            Effect::Resonance {
+                frequency_hz: 22.0,
+                damping_ratio: 0.04,
+                load_fraction: 0.75
+            }
+        );
+        assert_eq!(m.stribeck_exponent(), Some(0.8));
+        assert_eq!(Model::paper().stribeck_exponent(), None);
+        for (effects, path) in [
+            (
+                r#"{"effect": "drag", "coefficient": 1}, {"effect": "resonance", "frequency": 22, "damping_ratio": 0.04, "load_fraction": 1.0}"#,
+                "effects[1].load_fraction",
+            ),
+            (
+                r#"{"effect": "resonance", "frequency": -1, "damping_ratio": 0.04, "load_fraction": 0.5}"#,
+                "effects[0].frequency",
+            ),
+            (
+                r#"{"effect": "deadband", "current": -0.1}"#,
+                "effects[0].current",
+            ),
+            (
+                r#"{"effect": "stribeck_shape", "exponent": 0}"#,
+                "effects[0].exponent",
+            ),
+            (
+                r#"{"effect": "drag", "coefficient": -3}"#,
+                "effects[0].coefficient",
+            ),
+        ] {
+            let e = with_effects(effects).unwrap_err();
+            assert!(
+                matches!(&e, Error::Parameter { name, .. } if name == path),
+                "{e}"
+            );
+        }
+        let e = with_effects(
+            r#"{"effect": "stribeck_shape", "exponent": 1}, {"effect": "stribeck_shape", "exponent": 3}"#,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("more than one"), "{e}");
+    }
 }

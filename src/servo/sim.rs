@@ -4,7 +4,9 @@
 //! (zero-order hold); the plant is advanced in substeps between events (control
 //! instants and output samples). The default integrator updates the bristle state
 //! exactly with the velocity held and the mechanics by semi-implicit Euler: two `exp()`
-//! per step, no step-size limit from the bristle stiffness. RK4 is there for
+//! per step, no step-size limit from the bristle stiffness. With a `resonance` effect
+//! both bodies (motor and load) advance by semi-implicit Euler, which limits the step
+//! against the coupling's mode ([`check_resonance_step`]). RK4 is there for
 //! comparison. The algorithm is fixed in `docs/DESIGN.md` and mirrored step for step by
 //! `lugre.reference`.
 
@@ -123,8 +125,9 @@ impl<'a> Interp<'a> {
 
 /// Extra physics, flattened for the inner loop.
 ///
-/// `EXTRAS = false` is the plain axis (no current loop, current lag, delay, cogging or
-/// scaled friction; springs and offsets are kept): the simulation loop is compiled once
+/// `EXTRAS = false` is the plain axis (no current loop, current lag, delay, cogging,
+/// scaled friction, resonance, dead band, drag or Stribeck shape; springs and offsets
+/// are kept): the simulation loop is compiled once
 /// for it, with every test of the absent physics removed, and once for the general case.
 /// Both run the same code, so their results are identical.
 struct Physics<const EXTRAS: bool> {
