@@ -7,7 +7,7 @@ import os
 from collections.abc import Sequence
 from typing import Any
 
-from .io import _atomic_write
+from ._atomic import _atomic_write
 
 __all__ = ["figure", "save_png"]
 
