@@ -8,8 +8,8 @@ from html.parser import HTMLParser
 #: Attributes that make a browser fetch something.
 _FETCHING = {"src", "href", "srcset", "action", "poster", "data", "background", "xlink:href",
              "formaction", "manifest", "ping", "cite"}
-_CSS_URL = re.compile(r"url\(\s*['\"]?([^'\")]+)", re.I)
-_CSS_IMPORT = re.compile(r"@import\s+['\"]?([^'\";]+)", re.I)
+_CSS_URL = re.compile(r"url\(\s*['\"]?([^'\")]+)", re.IGNORECASE)
+_CSS_IMPORT = re.compile(r"@import\s+['\"]?([^'\";]+)", re.IGNORECASE)
 
 
 class _Refs(HTMLParser):
@@ -45,4 +45,4 @@ def external_references(page: str) -> list[str]:
     """Every reference in ``page`` that is not a ``data:`` URI or a ``#fragment``."""
     p = _Refs()
     p.feed(page)
-    return [r for r in p.refs if not (r.startswith("data:") or r.startswith("#"))]
+    return [r for r in p.refs if not r.startswith(("data:", "#"))]
