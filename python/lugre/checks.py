@@ -35,6 +35,17 @@ def require_plausible(rec: Recording) -> Recording:
         span more than 5 m or the speed exceeds 20 m/s: the fix is ``--x-unit mm`` /
         ``read_recording(..., x_unit="mm")`` or a mapping such as ``x=pos/1000``.
     """
+    from .readers import MAX_MAGNITUDE
+
+    for c in rec.columns:
+        a = getattr(rec, c)
+        big = np.flatnonzero(np.abs(a) > MAX_MAGNITUDE)
+        if big.size:
+            k = int(big[0])
+            raise DataError(
+                f"{_name(rec)}: sample {k} of column {c!r} is {a[k]:.6g}, beyond any "
+                f"measurement (|value| > {MAX_MAGNITUDE:g}): fix or remove the sample"
+            )
     t = rec.t
     if t.size < 3:
         return rec
