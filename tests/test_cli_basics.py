@@ -63,15 +63,19 @@ def test_import_lugre_is_light():
             "dt = time.perf_counter() - t; "
             "heavy = sorted(m for m in ('scipy', 'matplotlib') if m in sys.modules); "
             "print(dt, ','.join(heavy))")
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                       check=True)
-    dt, heavy = r.stdout.split()[0], r.stdout.split()[1:]
-    assert heavy == [], f"import lugre imports {heavy}"
-    assert float(dt) < 1.0  # 0.2 s on a quiet machine; loose for a busy one
+    times = []
+    for _ in range(3):  # the best of three: other work on the machine only adds time
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                           check=True)
+        dt, heavy = r.stdout.split()[0], r.stdout.split()[1:]
+        assert heavy == [], f"import lugre imports {heavy}"
+        times.append(float(dt))
+    assert min(times) <= 0.3, times
     # the lazy names still resolve
-    r = subprocess.run([sys.executable, "-c", "import lugre; lugre.fit_static; "
-                        "lugre.Diagnosis; print('scipy' in __import__('sys').modules)"],
-                       capture_output=True, text=True, check=True)
+    lazy = ("import lugre; lugre.fit_static; lugre.Diagnosis; "
+            "print('scipy' in __import__('sys').modules)")
+    r = subprocess.run([sys.executable, "-c", lazy], capture_output=True, text=True,
+                       check=True)
     assert r.stdout.strip() == "True"
     with pytest.raises(AttributeError):
         lugre.no_such_name  # noqa: B018
