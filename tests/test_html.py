@@ -78,6 +78,7 @@ def test_hand_built_report_renders_every_optional_key():
     assert "25 kg" in text and "25.4 kg" in text and "payload" in text
     assert "a 3 N burst stays unexplained." in text and "time 3 to 3.5 s" in text
     assert "sigma1 is poorly determined" in text
+    assert "To determine sigma1: short reversals" in text
     assert "a slow move in the other direction" in text
     assert page.count("data:image/png;base64,") == 1  # the finding's own figure
     assert "chi-square" not in text and "score by" not in text

@@ -411,9 +411,9 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--out", default="lugre-demo", help="directory for the PNG figures")
     d.set_defaults(func=_cmd_demo)
 
-    w = {"choices": ["igg", "huber", "tukey", "none"], "default": "igg",
+    w: dict[str, Any] = {"choices": ["igg", "huber", "tukey", "none"], "default": "igg",
          "help": "robust weights (igg as in the seed paper; none = least squares)"}
-    c = {"default": None, "metavar": "MAP",
+    c: dict[str, Any] = {"default": None, "metavar": "MAP",
          "help": "column mapping for other names or units, e.g. 'x=qm,F=gtau*vir' or "
                  "'x=pos/1000'"}
 

@@ -341,6 +341,22 @@ def _finding_section(k: int, f: dict[str, Any], data: dict[str, Any] | None,
     return "\n".join(out)
 
 
+_PARAM_WORD = re.compile(r"\b(sigma0|sigma1|sigma2|mass|force_constant|fc|fs|vs)\b")
+
+
+def _with_experiment(note: str) -> str:
+    """A note that says a parameter is not (or poorly) determined, with the experiment that
+    would determine it."""
+    if "determined" not in note.lower() and "tolerance" not in note.lower():
+        return note
+    names = list(dict.fromkeys(_PARAM_WORD.findall(note)))
+    if not names:
+        return note
+    exps = list(dict.fromkeys(EXPERIMENTS[n] for n in names))
+    return (note.rstrip() + (" " if note.rstrip().endswith(".") else ". ")
+            + f"To determine {', '.join(names)}: " + "; ".join(exps) + ".")
+
+
 def _base_moves(report: dict[str, Any]) -> list[list[str]]:
     rows = []
     moves = report.get("base_moves")
@@ -361,8 +377,13 @@ def _base_moves(report: dict[str, Any]) -> list[list[str]]:
         tol = b.get("tolerance")
         text = f"{100 * change:+.1f} %"
         if isinstance(tol, (int, float)) and tol:
-            text += (" (within what the record determines)" if abs(change) <= tol
-                     else f" (beyond the ±{100 * float(tol):.1f} % the record determines)")
+            if abs(change) <= tol:
+                text += " (within what the record determines)"
+            else:
+                base = name.rsplit(".", 1)[-1]
+                text += (f" (beyond the ±{100 * float(tol):.1f} % the record determines: "
+                         f"poorly determined here; to pin it down, "
+                         f"{EXPERIMENTS.get(base, 'a longer record')})")
         rows.append([escape(name.replace("_", " ")), escape(U.fmt(b.get("before"), unit)),
                      escape(U.fmt(b.get("after"), unit)), escape(text)])
     return rows
@@ -485,9 +506,9 @@ def diagnosis_page(report: dict[str, Any], data: dict[str, Any] | None = None, *
                 body.append(_figure(uri, f"Force residual against {name}; dashed: twice the "
                                          "noise floor."))
 
-    notes = report.get("notes") or []
+    notes = [_with_experiment(str(n)) for n in report.get("notes") or []]
     if notes:
-        body.append("<h2>Notes</h2><ul>" + "".join(f"<li>{escape(str(n))}</li>" for n in notes)
+        body.append("<h2>Notes</h2><ul>" + "".join(f"<li>{escape(n)}</li>" for n in notes)
                     + "</ul>")
     files = [f"recording {source}" if source else None, f"model {model}" if model else None,
              f"second run {holdout}" if holdout else None]
