@@ -183,3 +183,19 @@ def test_paper_html_cli(tmp_path):
     assert r.returncode == 0, r.stderr
     text = text_of((tmp_path / "paper.html").read_text())
     assert "Table 1" in text and "fc (v ≥ 0)" in text and "N/m" in text
+
+
+def test_long_profiles_are_summarised_in_units():
+    pos = list(np.linspace(-0.1, 0.2, 25))
+    scale = [1.0] * 25
+    scale[6] = 1.32
+    report = {"findings": [{"effect": "position_friction",
+                            "parameters": {"positions": pos, "scale": scale},
+                            "where": {"position": [-0.05, -0.03], "time": None,
+                                      "velocity": None},
+                            "explained": 0.9, "evidence": "friction changes along x."}],
+              "fit": {"before": {"rms_force": 2.8, "nrmse_force": 0.025},
+                      "after": {"rms_force": 0.23, "nrmse_force": 0.002}}}
+    text = text_of(diagnosis_page(report))
+    assert "25 values, −100 to 200 mm" in text
+    assert "largest change ×1.32 at −25 mm" in text

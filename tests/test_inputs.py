@@ -310,3 +310,11 @@ def test_fuzzed_tables_and_mappings_raise_lugre_errors(n, t, spec):
         lugre.io.as_recording(table, columns=spec)
     except LugreError:
         pass
+
+
+def test_fits_take_tables_too(case):
+    _, rec, believed = case
+    cols = {"t": rec.t, "x": rec.x, "i": rec.i}
+    a = lugre.fit_inverse_dynamics(rec, force_constant=believed.force_constant)
+    b = lugre.fit_inverse_dynamics(cols, force_constant=believed.force_constant)
+    assert a.mass == pytest.approx(b.mass)

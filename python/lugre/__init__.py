@@ -36,28 +36,18 @@ from .io import Recording, read_points, read_recording, write_recording
 from .model import Model, load_model, save_model
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .diagnosis import Diagnosis, fit_inverse_dynamics
-    from .identify import (
-        DynamicFit,
-        StaticFit,
-        SteadyStatePoints,
-        fit_dynamic,
-        fit_static,
-        steady_state_points,
-    )
+    from .diagnosis import Diagnosis
+    from .identify import DynamicFit, StaticFit, SteadyStatePoints, fit_static
 
 __version__ = "0.1.0"
 
 #: Names imported on first use, with the module that defines them.
 _LAZY = {
     "Diagnosis": ".diagnosis",
-    "fit_inverse_dynamics": ".diagnosis",
     "DynamicFit": ".identify",
     "StaticFit": ".identify",
     "SteadyStatePoints": ".identify",
-    "fit_dynamic": ".identify",
     "fit_static": ".identify",
-    "steady_state_points": ".identify",
 }
 
 
@@ -103,6 +93,41 @@ def evaluate(recording: Any, model: Any, **kwargs: Any) -> Any:
     from .tabular import as_recording
 
     return _evaluate(require_plausible(as_recording(recording)), model, **kwargs)
+
+
+def _table_or_same(recording: Any) -> Any:
+    """A table with named columns as a :class:`Recording`; anything else unchanged (paths
+    and recordings are read and checked where they are used)."""
+    from .tabular import as_recording, table_columns
+
+    if (isinstance(recording, (Recording, str, bytes)) or hasattr(recording, "__fspath__")
+            or table_columns(recording) is None):
+        return recording
+    return as_recording(recording)
+
+
+def fit_inverse_dynamics(recording: Any, *args: Any, **kwargs: Any) -> Any:
+    """Mass and LuGre friction by robust inverse dynamics; ``recording`` may be a table
+    with named columns. See :func:`lugre.diagnosis.fit_inverse_dynamics`."""
+    from .diagnosis import fit_inverse_dynamics as _fit
+
+    return _fit(_table_or_same(recording), *args, **kwargs)
+
+
+def fit_dynamic(recording: Any, *args: Any, **kwargs: Any) -> Any:
+    """sigma0 and sigma1 from a closed-loop record; ``recording`` may be a table with
+    named columns. See :func:`lugre.identify.fit_dynamic`."""
+    from .identify import fit_dynamic as _fit
+
+    return _fit(_table_or_same(recording), *args, **kwargs)
+
+
+def steady_state_points(recording: Any, *args: Any, **kwargs: Any) -> Any:
+    """Steady-state (v, F) points of a plateau record; ``recording`` may be a table with
+    named columns. See :func:`lugre.identify.steady_state_points`."""
+    from .identify import steady_state_points as _points
+
+    return _points(_table_or_same(recording), *args, **kwargs)
 
 
 __all__ = [

@@ -167,6 +167,20 @@ def _effect_title(effect: str) -> str:
     return effect.replace("_", " ")
 
 
+def _list_summary(name: str, vals: list[float], unit: tuple[str, float],
+                  params: dict[str, Any]) -> str:
+    """A long list parameter in one line: its span, and for a scale profile the largest
+    change and where it is."""
+    lo, hi = min(vals), max(vals)
+    text = f"{len(vals)} values, {U.fmt_range(lo, hi, unit)}"
+    pos = params.get("positions")
+    if name == "scale" and isinstance(pos, (list, tuple)) and len(pos) == len(vals):
+        k = max(range(len(vals)), key=lambda j: abs(vals[j] - 1.0))
+        text += (f"; largest change ×{U.num(vals[k])} at "
+                 f"{U.fmt(pos[k], U.EFFECT_UNITS['position_friction']['positions'])}")
+    return text
+
+
 def _param_rows(effect: str, params: dict[str, Any], unc: dict[str, Any]) -> list[list[str]]:
     rows = []
     for name, val in params.items():
@@ -183,7 +197,11 @@ def _param_rows(effect: str, params: dict[str, Any], unc: dict[str, Any]) -> lis
             interval = "–"
         else:
             interval = escape(U.fmt(iv, unit) if isinstance(iv, (int, float, list)) else str(iv))
-        value = U.fmt(val, unit) if isinstance(val, (int, float, list, tuple)) else str(val)
+        if isinstance(val, (list, tuple)) and len(val) > 4 and all(
+                isinstance(v, (int, float)) for v in val):
+            value = _list_summary(name, list(val), unit, params)
+        else:
+            value = U.fmt(val, unit) if isinstance(val, (int, float, list, tuple)) else str(val)
         rows.append([escape(name.replace("_", " ")), escape(value), escape(interval)])
     return rows
 
