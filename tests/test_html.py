@@ -96,9 +96,9 @@ def test_shares_add_up_to_one_hundred():
 def test_minimal_report_degrades_gracefully():
     page = diagnosis_page({"findings": [], "fit": {}})
     text = text_of(page)
-    assert "Nothing beyond noise" in text and external_references(page) == []
+    assert "No missing physics" in text and external_references(page) == []
     page = diagnosis_page({"findings": [], "fit": {}, "unexplained": {"message": "odd."}})
-    assert "odd." in text_of(page) and "Nothing beyond noise" not in text_of(page)
+    assert "odd." in text_of(page) and "No missing physics" not in text_of(page)
 
 
 def test_plain_text_has_no_internal_scores():

@@ -288,9 +288,20 @@ def _verdict(report: dict[str, Any]) -> tuple[str, bool]:
                    f"{u.get('message', '')} Look at where it lives (below) and record "
                    "that range again with a slower, longer move.")
             return msg, False
-        msg = ("Nothing beyond noise: the model explains this record within its noise "
-               "floor. Keep the model; check again with a record that moves over the "
-               "whole stroke at several speeds.")
+        msg = ("No missing physics: beyond the noise floor, no effect of the vocabulary "
+               "explains the residual. ")
+        g = _gain(fit.get("before"), fit.get("after"))
+        try:
+            moved = float(fit["after"]["rms_force"]) < 0.8 * float(fit["before"]["rms_force"])
+        except (KeyError, TypeError, ValueError):
+            moved = False
+        if moved and g:
+            msg += (f"Re-estimating the base parameters on this record alone takes the "
+                    f"residual {g}: use the re-estimated model (--out-model), and check "
+                    "the parameters flagged below as poorly determined before trusting them.")
+        else:
+            msg += ("Keep the model; check again with a record that moves over the whole "
+                    "stroke at several speeds.")
         return msg, True
     names = ", ".join(_effect_title(str(f.get("effect"))) for f in findings)
     first = findings[0]
@@ -458,9 +469,9 @@ def diagnosis_page(report: dict[str, Any], data: dict[str, Any] | None = None, *
     body.append("<h2>How much the model misses</h2>")
     rows = []
     for key, label in (("before", "this record, model as given"),
-                       ("after", "this record, with the findings"),
+                       ("after", "this record, after the refit"),
                        ("holdout_before", "second run, model as given"),
-                       ("holdout_after", "second run, with the findings")):
+                       ("holdout_after", "second run, after the refit")):
         m = fit.get(key)
         if m:
             rows.append([escape(label), escape(U.fmt(m.get("rms_force"), "N")),
