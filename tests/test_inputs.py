@@ -318,3 +318,18 @@ def test_fits_take_tables_too(case):
     a = lugre.fit_inverse_dynamics(rec, force_constant=believed.force_constant)
     b = lugre.fit_inverse_dynamics(cols, force_constant=believed.force_constant)
     assert a.mass == pytest.approx(b.mass)
+
+
+@pytest.mark.parametrize(("extra", "option"), [
+    (["--columns", "x"], "--columns"),
+    (["--force-constant", "-1"], "--force-constant"),
+    (["--force-constant", "abc"], "--force-constant"),
+    (["--force-constant", "25", "--mass", "0"], "--mass"),
+    (["--force-constant", "25", "--x-unit", "inch"], "--x-unit"),
+])
+def test_bad_options_are_one_line_usage_errors(case, tmp_path, extra, option):
+    d, _, _ = case
+    r = run("fit", d / "rec.csv", "--json", tmp_path / "m.json", *extra)
+    line = one_line_error(r)
+    assert r.returncode == 2 and option in line, line
+    assert not (tmp_path / "m.json").exists()

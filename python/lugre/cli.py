@@ -77,6 +77,28 @@ def _check_outputs(inputs: dict[str, str | None], outputs: dict[str, str | None]
                                     "directory for the figures")
 
 
+def _number(kind: type, low: float, strict: bool, what: str) -> Any:
+    """An argparse type: a finite number above ``low`` (or at least ``low``)."""
+    import math
+
+    def parse(text: str) -> Any:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number: give {what}") from None
+        if not math.isfinite(value) or (value <= low if strict else value < low):
+            raise argparse.ArgumentTypeError(f"{text} is out of range: give {what}")
+        return value
+
+    return parse
+
+
+_POSITIVE = _number(float, 0.0, True, "a positive number")
+_NONNEGATIVE = _number(float, 0.0, False, "a number >= 0")
+_COUNT = _number(int, 0.0, True, "a whole number >= 1")
+_COUNT0 = _number(int, 0.0, False, "a whole number >= 0")
+
+
 def _columns(spec: str | None) -> str | None:
     return spec or None
 
@@ -121,7 +143,14 @@ def _read(args: argparse.Namespace, path: str, option: str = "RECORDING") -> Any
     from .checks import require_plausible, resample_uniform
     from .io import read_recording
 
-    rec = read_recording(path, _columns(args.columns), x_unit=getattr(args, "x_unit", "m"))
+    try:
+        rec = read_recording(path, _columns(args.columns),
+                             x_unit=getattr(args, "x_unit", "m"))
+    except InputError as e:
+        if e.name in ("columns", "x_unit"):
+            text = str(e).split(": ", 1)[-1]
+            raise UsageError.option("--" + e.name.replace("_", "-"), text) from None
+        raise
     if getattr(args, "resample", False):
         n = len(rec)
         rec = resample_uniform(rec)
@@ -366,6 +395,13 @@ def _cmd_paper(args: argparse.Namespace) -> int:
 # --------------------------------------------------------------------------------------
 
 
+class _Parser(argparse.ArgumentParser):
+    """Usage errors in one line, with where to read more (exit status 2)."""
+
+    def error(self, message: str) -> Any:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 class _Formatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
     """Defaults in the help, examples kept as written."""
 
@@ -394,14 +430,14 @@ def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand."""
     from . import __version__
 
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="lugre",
         description="LuGre friction: simulate servo axes, identify friction, diagnose mismatch.",
         epilog="examples:\n  " + "\n  ".join(_EXAMPLES[k] for k in ("fit", "diagnose")),
         formatter_class=_Formatter,
     )
     p.add_argument("--version", action="version", version=f"lugre {__version__}")
-    quiet = argparse.ArgumentParser(add_help=False)
+    quiet = _Parser(add_help=False)
     quiet.add_argument("-q", "--quiet", action="store_true",
                        help="no progress lines on stderr (they appear only on a terminal)")
     common = [quiet]
@@ -433,11 +469,12 @@ def build_parser() -> argparse.ArgumentParser:
     fs.add_argument("--model", metavar="BASE.json",
                     help="take axis, sigma0, sigma1, effects and controller from this model "
                          "(without it the seed paper's values are placeholders)")
-    fs.add_argument("--force-constant", type=float, help="K_F [N/A] for a record of currents")
-    fs.add_argument("--mass", type=float, help="moving mass [kg] to write into the model")
+    fs.add_argument("--force-constant", type=_POSITIVE,
+                    help="K_F [N/A] for a record of currents")
+    fs.add_argument("--mass", type=_POSITIVE, help="moving mass [kg] to write into the model")
     fs.add_argument("--weighting", **w)
     recording_options(fs)
-    fs.add_argument("--chunks", type=int, default=3,
+    fs.add_argument("--chunks", type=_COUNT, default=3,
                     help="points per settled plateau of a raw record")
     fs.add_argument("--plot", metavar="PNG", help="write a figure of the fit")
     fs.add_argument("--html", metavar="PAGE.html", help="write a self-contained HTML page")
@@ -449,9 +486,10 @@ def build_parser() -> argparse.ArgumentParser:
     fd.add_argument("--model", required=True, metavar="STATIC.json")
     fd.add_argument("--json", required=True, metavar="MODEL.json")
     fd.add_argument("--weighting", **w)
-    fd.add_argument("--c1", type=float, default=1.0, help="weight of sum(e^2) (eq. 18)")
-    fd.add_argument("--c2", type=float, default=0.0, help="weight of max|e| (eq. 18)")
-    fd.add_argument("--resolution", type=float, default=0.0,
+    fd.add_argument("--c1", type=_NONNEGATIVE, default=1.0,
+                    help="weight of sum(e^2) (eq. 18)")
+    fd.add_argument("--c2", type=_NONNEGATIVE, default=0.0, help="weight of max|e| (eq. 18)")
+    fd.add_argument("--resolution", type=_NONNEGATIVE, default=0.0,
                     help="encoder resolution [m]: lower bound of the residual scale")
     recording_options(fd)
     fd.set_defaults(func=_cmd_fit_dynamic)
@@ -482,8 +520,9 @@ def build_parser() -> argparse.ArgumentParser:
               "in both directions (robust inverse dynamics)", common)
     ft.add_argument("recording", metavar="RECORDING")
     ft.add_argument("--json", required=True, metavar="MODEL.json")
-    ft.add_argument("--mass", type=float, help="known moving mass [kg] (estimated otherwise)")
-    ft.add_argument("--force-constant", type=float,
+    ft.add_argument("--mass", type=_POSITIVE,
+                    help="known moving mass [kg] (estimated otherwise)")
+    ft.add_argument("--force-constant", type=_POSITIVE,
                     help="K_F [N/A]; needed when the recording holds the current i")
     ft.add_argument("--no-refine", action="store_true",
                     help="stop after the inverse-dynamics least squares")
@@ -495,7 +534,7 @@ def build_parser() -> argparse.ArgumentParser:
               "tracking) beside its numbers, with PNG figures", common)
     pp.add_argument("--out", default="lugre-paper", help="directory for the figures")
     pp.add_argument("--seed", type=int, default=1, help="random seed of the synthetic data")
-    pp.add_argument("--monte-carlo", type=int, default=40,
+    pp.add_argument("--monte-carlo", type=_COUNT0, default=40,
                     help="static datasets for the Monte Carlo summary (0 to skip)")
     pp.add_argument("--html", metavar="PAGE.html", help="the tables as a self-contained page")
     pp.set_defaults(func=_cmd_paper)
