@@ -567,7 +567,8 @@ def _model_rows(doc: dict[str, Any]) -> list[list[str]]:
     return rows
 
 
-def _stribeck_uri(doc: dict[str, Any], v: Any = None, F: Any = None) -> str | None:
+def _stribeck_uri(doc: dict[str, Any], v: Any = None, F: Any = None,
+                  rejected: Any = None) -> str | None:
     import numpy as np
 
     from ._native import stribeck
@@ -581,8 +582,14 @@ def _stribeck_uri(doc: dict[str, Any], v: Any = None, F: Any = None) -> str | No
         grid = np.linspace(-vmax, vmax, 801)
         series = [(1e3 * grid, stribeck(grid, m), "-", "fitted steady-state friction")]
         if v is not None and F is not None:
-            series.insert(0, (1e3 * np.asarray(v, float), np.asarray(F, float), "o",
-                              "steady-state points"))
+            va, Fa = np.asarray(v, float), np.asarray(F, float)
+            bad = np.zeros(va.size, bool)
+            if rejected is not None and len(rejected):
+                bad[np.asarray(rejected, int)] = True
+            series.insert(0, (1e3 * va[~bad], Fa[~bad], "o", "steady-state points"))
+            if bad.any():
+                series.insert(1, (1e3 * va[bad], Fa[bad], "x",
+                                  "rejected as gross errors"))
         return curve_figure(series, "velocity [mm/s]", "friction force [N]")
     except (ValueError, KeyError, TypeError):
         return None
@@ -606,8 +613,8 @@ def static_fit_page(fit: Any, v: Any, F: Any, model: dict[str, Any], *,
                 f"points, {n_rej} rejected as gross errors ({escape(fit.weighting)} weights).</div>")
     body.append("<h2>Stribeck parameters</h2>")
     body.append(_table(["parameter", "estimate", "95 % interval"], rows, {1}))
-    body.append(_figure(_stribeck_uri(model, v, F), "Steady-state points and the fitted "
-                        "friction curve."))
+    body.append(_figure(_stribeck_uri(model, v, F, fit.rejected), "Steady-state points, "
+                        "those rejected as gross errors, and the fitted friction curve."))
     if assumed:
         body.append("<h2>Placeholders in the model</h2>")
         body.append(_p("Steady-state points do not determine " + ", ".join(assumed) + "; the "
