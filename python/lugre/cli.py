@@ -144,8 +144,9 @@ def _read(args: argparse.Namespace, path: str, option: str = "RECORDING") -> Any
     from .io import read_recording
 
     try:
-        rec = read_recording(path, _columns(args.columns),
-                             x_unit=getattr(args, "x_unit", "m"))
+        with _progress(args).step(f"reading {path}"):
+            rec = read_recording(path, _columns(args.columns),
+                                 x_unit=getattr(args, "x_unit", "m"))
     except InputError as e:
         if e.name in ("columns", "x_unit"):
             text = str(e).split(": ", 1)[-1]
