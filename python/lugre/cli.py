@@ -404,7 +404,12 @@ class _Parser(argparse.ArgumentParser):
 
 
 class _Formatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
-    """Defaults in the help, examples kept as written."""
+    """Defaults in the help (where there is one to state), examples kept as written."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        if action.default in (None, False) or action.default is argparse.SUPPRESS:
+            return action.help
+        return super()._get_help_string(action)
 
 
 _EXAMPLES = {
@@ -484,8 +489,9 @@ def build_parser() -> argparse.ArgumentParser:
     fd = _add(sub, "fit-dynamic", "sigma0 and sigma1 from a closed-loop record (with x_ref) "
               "under the model's controller, static sets held", common)
     fd.add_argument("recording", metavar="RECORDING")
-    fd.add_argument("--model", required=True, metavar="STATIC.json")
-    fd.add_argument("--json", required=True, metavar="MODEL.json")
+    fd.add_argument("--model", required=True, metavar="STATIC.json",
+                    help="model with the static sets and the controller")
+    fd.add_argument("--json", required=True, metavar="MODEL.json", help="model to write")
     fd.add_argument("--weighting", **w)
     fd.add_argument("--c1", type=_NONNEGATIVE, default=1.0,
                     help="weight of sum(e^2) (eq. 18)")
@@ -498,9 +504,10 @@ def build_parser() -> argparse.ArgumentParser:
     dg = _add(sub, "diagnose", "locate where the model misses the recording, name the "
               "missing physics, refit, and show the gain on held-out data", common)
     dg.add_argument("recording", metavar="RECORDING")
-    dg.add_argument("--model", required=True, metavar="MODEL.json")
+    dg.add_argument("--model", required=True, metavar="MODEL.json",
+                    help="the model the recording is checked against")
     dg.add_argument("--holdout", metavar="RECORDING2", help="a second run for validation")
-    dg.add_argument("--json", required=True, metavar="REPORT.json")
+    dg.add_argument("--json", required=True, metavar="REPORT.json", help="report to write")
     dg.add_argument("--out-model", metavar="AUGMENTED.json",
                     help="the model with the findings added to its effects")
     dg.add_argument("--html", metavar="REPORT.html",
@@ -512,15 +519,16 @@ def build_parser() -> argparse.ArgumentParser:
     ev = _add(sub, "evaluate", "rms and normalised rms of the inverse-dynamics force "
               "residual of a model on a recording", common)
     ev.add_argument("recording", metavar="RECORDING")
-    ev.add_argument("--model", required=True, metavar="MODEL.json")
-    ev.add_argument("--json", required=True, metavar="EVAL.json")
+    ev.add_argument("--model", required=True, metavar="MODEL.json", help="the model")
+    ev.add_argument("--json", required=True, metavar="EVAL.json",
+                    help="evaluation to write (rms_force [N], nrmse_force)")
     recording_options(ev)
     ev.set_defaults(func=_cmd_evaluate)
 
     ft = _add(sub, "fit", "identify mass and LuGre friction from any recording with motion "
               "in both directions (robust inverse dynamics)", common)
     ft.add_argument("recording", metavar="RECORDING")
-    ft.add_argument("--json", required=True, metavar="MODEL.json")
+    ft.add_argument("--json", required=True, metavar="MODEL.json", help="model to write")
     ft.add_argument("--mass", type=_POSITIVE,
                     help="known moving mass [kg] (estimated otherwise)")
     ft.add_argument("--force-constant", type=_POSITIVE,
