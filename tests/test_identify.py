@@ -164,7 +164,7 @@ def test_cli_fit_static_and_refusal_to_overwrite(tmp_path):
     assert png.stat().st_size > 10_000
     before = out.read_bytes()
     r = run_cli("fit-static", str(out), "--json", str(out))
-    assert r.returncode == 1 and "never overwritten" in r.stderr
+    assert r.returncode == 2 and "never overwritten" in r.stderr
     assert out.read_bytes() == before
     r = run_cli("fit-static", str(STATIC / "paper_axis_plateaus.csv"), "--json",
                 str(tmp_path / "x.json"))

@@ -1,95 +1,120 @@
-"""The ``lugre`` command line."""
+"""The ``lugre`` command line.
+
+Exit status: 0 on success, 2 for a usage problem (an option, an output that would
+overwrite an input), 1 for a problem with the data or a file. Every error is one line on
+stderr naming the file, row, column or option and the fix; nothing is written when a
+command refuses.
+"""
 
 from __future__ import annotations
 
 import argparse
 import os
 import sys
+import warnings
 from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
 
 from .exceptions import InputError, LugreError
 
 __all__ = ["main"]
 
 
-def _guard_output(out: str | None, *inputs: str | None) -> None:
-    """Refuse to write over an input: nothing the user gave is overwritten."""
-    if out is None:
-        return
-    for i in inputs:
-        if i and os.path.exists(i) and os.path.exists(out) and os.path.samefile(i, out):
-            raise InputError.at("--json", f"{out} is also an input: choose another output "
-                                "file (inputs are never overwritten)")
+class UsageError(InputError):
+    """A command-line option is unusable (exit status 2)."""
+
+    @classmethod
+    def option(cls, option: str, message: str) -> UsageError:
+        return cls(f"{option}: {message}", name=option)
+
+
+# --------------------------------------------------------------------------------------
+# Outputs: checked before any work, written at the end, never over an input
+# --------------------------------------------------------------------------------------
+
+
+def _same(a: str, b: str) -> bool:
+    if os.path.exists(a) and os.path.exists(b):
+        return os.path.samefile(a, b)
+    return os.path.abspath(a) == os.path.abspath(b)
+
+
+def _check_outputs(inputs: dict[str, str | None], outputs: dict[str, str | None],
+                   dirs: dict[str, str | None] | None = None) -> None:
+    """Refuse outputs that would overwrite an input or each other, or cannot be written.
+
+    ``inputs`` and ``outputs`` map the option (``--json``, ``RECORDING``) to the path;
+    ``dirs`` are output directories (``--plots``).
+    """
+    given_in = {k: v for k, v in inputs.items() if v}
+    given_out = {k: v for k, v in outputs.items() if v}
+    given_dirs = {k: v for k, v in (dirs or {}).items() if v}
+    for opt, out in given_out.items():
+        for iopt, inp in given_in.items():
+            if _same(out, inp):
+                raise UsageError.option(opt, f"{out} is the {iopt} input: choose another "
+                                        "output file (inputs are never overwritten)")
+        parent = os.path.dirname(os.path.abspath(out))
+        if not os.path.isdir(parent):
+            raise UsageError.option(opt, f"cannot write {out}: the directory {parent} does "
+                                    "not exist: create it first or choose another path")
+        if os.path.isdir(out):
+            raise UsageError.option(opt, f"{out} is a directory: give a file name")
+    items = list(given_out.items()) + list(given_dirs.items())
+    for a in range(len(items)):
+        for b in range(a + 1, len(items)):
+            if _same(items[a][1], items[b][1]):
+                raise UsageError.option(items[b][0], f"{items[b][1]} is also given to "
+                                        f"{items[a][0]}: give each output its own path")
+    for opt, d in given_dirs.items():
+        for iopt, inp in given_in.items():
+            if _same(d, inp):
+                raise UsageError.option(opt, f"{d} is the {iopt} input: choose another "
+                                        "directory")
+        if os.path.exists(d) and not os.path.isdir(d):
+            raise UsageError.option(opt, f"{d} exists and is not a directory: give a "
+                                    "directory for the figures")
+
+
+def _number(kind: type, low: float, strict: bool, what: str) -> Any:
+    """An argparse type: a finite number above ``low`` (or at least ``low``)."""
+    import math
+
+    def parse(text: str) -> Any:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number: give {what}") from None
+        if not math.isfinite(value) or (value <= low if strict else value < low):
+            raise argparse.ArgumentTypeError(f"{text} is out of range: give {what}")
+        return value
+
+    return parse
+
+
+_POSITIVE = _number(float, 0.0, True, "a positive number")
+_NONNEGATIVE = _number(float, 0.0, False, "a number >= 0")
+_COUNT = _number(int, 0.0, True, "a whole number >= 1")
+_COUNT0 = _number(int, 0.0, False, "a whole number >= 0")
 
 
 def _columns(spec: str | None) -> str | None:
     return spec or None
 
 
-def _cmd_fit_static(args: argparse.Namespace) -> int:
-    from .identify import fit_static, steady_state_points
-    from .io import is_points_file, read_points
-    from .model import load_model, save_model
-
-    _guard_output(args.json, args.data, args.model)
-    base = load_model(args.model) if args.model else None
-    if is_points_file(args.data):
-        v, F = read_points(args.data)
-        print(f"{args.data}: {len(v)} steady-state points")
-    else:
-        kf = args.force_constant or (base.force_constant if base else None)
-        pts = steady_state_points(args.data, kf, columns=_columns(args.columns),
-                                  chunks=args.chunks)
-        used = sum(p["settled"] for p in pts.plateaus)
-        print(f"{args.data}: {len(pts.plateaus)} plateaus found, {used} settled and used "
-              f"({int(pts.used.sum())} samples) -> {len(pts.v)} points")
-        for n in pts.notes:
-            print(f"  {n}")
-        v, F = pts.v, pts.F
-    fit = fit_static(v, F, weighting=args.weighting)
-    print(fit.summary())
-    axis = {}
-    if args.mass:
-        axis["mass"] = args.mass
-    if args.force_constant:
-        axis["force_constant"] = args.force_constant
-    model = fit.to_model(base, **axis)
-    save_model(model, args.json)
-    print(f"model written to {args.json}")
-    if args.plot:
-        from .plots import static_fit_figure
-
-        print(f"plot written to {static_fit_figure(v, F, fit, args.plot)}")
-    return 0
-
-
-def _cmd_fit_dynamic(args: argparse.Namespace) -> int:
-    from .identify import fit_dynamic
-    from .model import load_model, save_model
-
-    _guard_output(args.json, args.recording, args.model)
-    model = load_model(args.model)
-    fit = fit_dynamic(args.recording, model, weighting=args.weighting, c1=args.c1, c2=args.c2,
-                      columns=_columns(args.columns), scale_floor=args.resolution)
-    print(fit.summary())
-    save_model(fit.to_model(), args.json)
-    print(f"model written to {args.json}")
-    return 0
-
-
-def _cmd_demo(args: argparse.Namespace) -> int:
-    from .demo import run_demo
-
-    run_demo(args.out)
-    return 0
-
-
 def _write_json(path: str, obj: object) -> None:
     import json
 
-    from .io import _atomic_write
+    from ._atomic import atomic_write
 
-    _atomic_write(path, (json.dumps(obj, indent=2, default=_jsonable) + "\n").encode())
+    atomic_write(path, (json.dumps(obj, indent=2, default=_jsonable) + "\n").encode())
+
+
+def _write_text(path: str, text: str) -> None:
+    from ._atomic import atomic_write
+
+    atomic_write(path, text.encode("utf-8"))
 
 
 def _jsonable(o: object) -> object:
@@ -102,65 +127,237 @@ def _jsonable(o: object) -> object:
     raise TypeError(f"cannot write {type(o).__name__} to JSON")
 
 
-def _cmd_diagnose(args: argparse.Namespace) -> int:
-    from pathlib import Path
+def _progress(args: argparse.Namespace) -> Any:
+    from ._progress import Progress
 
-    from .diagnosis import diagnose, write_plots
+    return Progress(enabled=None if not getattr(args, "quiet", False) else False)
+
+
+def _note(msg: str) -> None:
+    print(f"note: {msg}", file=sys.stderr)
+
+
+def _read(args: argparse.Namespace, path: str, option: str = "RECORDING") -> Any:
+    """Read a recording with the command's column mapping, unit and resampling options,
+    and refuse it when its sampling has gaps or its units look wrong."""
+    from .checks import require_plausible, resample_uniform
     from .io import read_recording
+
+    try:
+        with _progress(args).step(f"reading {path}"):
+            rec = read_recording(path, _columns(args.columns),
+                                 x_unit=getattr(args, "x_unit", "m"))
+    except InputError as e:
+        if e.name in ("columns", "x_unit"):
+            text = str(e).split(": ", 1)[-1]
+            raise UsageError.option("--" + e.name.replace("_", "-"), text) from None
+        raise
+    if getattr(args, "resample", False):
+        n = len(rec)
+        rec = resample_uniform(rec)
+        print(f"{path}: resampled: {n} samples linearly interpolated onto a uniform grid of "
+              f"{len(rec)} samples, dt = {rec.dt:.6g} s")
+    return require_plausible(rec)
+
+
+# --------------------------------------------------------------------------------------
+# Commands
+# --------------------------------------------------------------------------------------
+
+
+#: What ``fit-static`` writes without a --model when the static step cannot tell it.
+_PAPER_PLACEHOLDERS = ("axis.mass", "axis.force_constant", "friction.sigma0",
+                       "friction.sigma1")
+
+
+def _cmd_fit_static(args: argparse.Namespace) -> int:
+    from .identify import fit_static, steady_state_points
+    from .io import is_points_file, read_points
+    from .model import Model, load_model, save_model
+
+    _check_outputs({"POINTS_OR_RECORDING": args.data, "--model": args.model},
+                   {"--json": args.json, "--plot": args.plot, "--html": args.html})
+    base = load_model(args.model) if args.model else None
+    pr = _progress(args)
+    if is_points_file(args.data):
+        v, F = read_points(args.data)
+        print(f"{args.data}: {len(v)} steady-state points")
+    else:
+        kf = args.force_constant or (base.force_constant if base else None)
+        with pr.step(f"finding the plateaus of {args.data}"):
+            pts = steady_state_points(_read(args, args.data), kf, chunks=args.chunks)
+        used = sum(p["settled"] for p in pts.plateaus)
+        print(f"{args.data}: {len(pts.plateaus)} plateaus found, {used} settled and used "
+              f"({int(pts.used.sum())} samples) -> {len(pts.v)} points")
+        for n in pts.notes:
+            print(f"  {n}")
+        v, F = pts.v, pts.F
+    with pr.step("fitting the Stribeck curves"):
+        fit = fit_static(v, F, weighting=args.weighting)
+    print(fit.summary())
+    axis = {}
+    if args.mass:
+        axis["mass"] = args.mass
+    if args.force_constant:
+        axis["force_constant"] = args.force_constant
+    model = fit.to_model(base, **axis)
+    assumed: list[str] = []
+    if base is None:
+        assumed = [p for p in _PAPER_PLACEHOLDERS
+                   if not (p == "axis.mass" and args.mass)
+                   and not (p == "axis.force_constant" and args.force_constant)]
+        if assumed:
+            paper = Model.paper()
+            vals = {"axis.mass": f"{paper.mass:g} kg",
+                    "axis.force_constant": f"{paper.force_constant:g} N/A",
+                    "friction.sigma0": f"{paper.sigma0:g} N/m",
+                    "friction.sigma1": f"{paper.sigma1:g} N s/m"}
+            text = ", ".join(f"{p} = {vals[p]}" for p in assumed)
+            _note(f"{args.json}: the static fit cannot tell {', '.join(assumed)}; the model "
+                  f"holds the seed paper's values ({text}) as placeholders: give --model "
+                  "BASE.json (or --mass/--force-constant) and run fit-dynamic for sigma0, "
+                  "sigma1")
+            d = model.to_dict()
+            d["placeholders"] = {
+                "parameters": assumed,
+                "source": "seed paper (lugre.Model.paper())",
+                "why": "steady-state friction points do not determine these; replace them "
+                       "(--model, --mass, --force-constant, lugre fit-dynamic)",
+            }
+            model = Model.from_dict(d)
+    page = None
+    if args.html:
+        from .html import static_fit_page
+
+        with pr.step("rendering the HTML page"):
+            page = static_fit_page(fit, v, F, model.to_dict(), source=args.data,
+                                   assumed=assumed)
+    save_model(model, args.json)
+    print(f"model written to {args.json}")
+    if args.plot:
+        from .plots import static_fit_figure
+
+        print(f"plot written to {static_fit_figure(v, F, fit, args.plot)}")
+    if page is not None:
+        _write_text(args.html, page)
+        print(f"page written to {args.html}")
+    return 0
+
+
+def _cmd_fit_dynamic(args: argparse.Namespace) -> int:
+    from .identify import fit_dynamic
     from .model import load_model, save_model
 
-    _guard_output(args.json, args.recording, args.model, args.holdout)
-    _guard_output(args.out_model, args.recording, args.model, args.holdout)
+    _check_outputs({"RECORDING": args.recording, "--model": args.model}, {"--json": args.json})
     model = load_model(args.model)
-    rec = read_recording(args.recording, _columns(args.columns))
-    hold = read_recording(args.holdout, _columns(args.columns)) if args.holdout else None
-    d = diagnose(rec, model, holdout=hold)
+    rec = _read(args, args.recording)
+    with _progress(args).step("fitting sigma0 and sigma1 (closed-loop simulations)"):
+        fit = fit_dynamic(rec, model, weighting=args.weighting, c1=args.c1, c2=args.c2,
+                          scale_floor=args.resolution)
+    print(fit.summary())
+    save_model(fit.to_model(), args.json)
+    print(f"model written to {args.json}")
+    return 0
+
+
+def _cmd_demo(args: argparse.Namespace) -> int:
+    from .demo import run_demo
+
+    _check_outputs({}, {}, {"--out": args.out})
+    with _progress(args).step("simulating the demo"):
+        run_demo(args.out)
+    return 0
+
+
+def _cmd_diagnose(args: argparse.Namespace) -> int:
+    from .diagnosis import diagnose, write_plots
+    from .model import load_model, save_model
+
+    plots = args.plots or str(Path(args.json).with_suffix("")) + "_plots"
+    _check_outputs({"RECORDING": args.recording, "--model": args.model,
+                    "--holdout": args.holdout},
+                   {"--json": args.json, "--out-model": args.out_model, "--html": args.html},
+                   {"--plots": plots})
+    pr = _progress(args)
+    model = load_model(args.model)
+    rec = _read(args, args.recording)
+    hold = _read(args, args.holdout, "--holdout") if args.holdout else None
+    with pr.step("diagnosing (candidate effects, joint refits, held-out checks)"):
+        d = diagnose(rec, model, holdout=hold, screw_lead=args.screw_lead)
     print(d.summary())
-    _write_json(args.json, d.to_dict())
+    report = d.to_dict()
+    page = None
+    if args.html:
+        from .html import diagnosis_page
+
+        with pr.step("rendering the HTML report"):
+            page = diagnosis_page(report, d.data, source=args.recording,
+                                  model=args.model, holdout=args.holdout,
+                                  resampled=rec.meta.get("resampled"))
+    _write_json(args.json, report)
     print(f"report written to {args.json}")
     if args.out_model:
         save_model(d.augmented_model(), args.out_model)
         print(f"augmented model written to {args.out_model}")
-    plots = args.plots or str(Path(args.json).with_suffix("")) + "_plots"
-    files = write_plots(d, plots)
+    if page is not None:
+        _write_text(args.html, page)
+        print(f"page written to {args.html}")
+    with pr.step("drawing the figures"):
+        files = write_plots(d, plots)
     print(f"{len(files)} plots written to {plots}/")
     return 0
 
 
 def _cmd_evaluate(args: argparse.Namespace) -> int:
     from .diagnosis import evaluate
-    from .io import read_recording
     from .model import load_model
 
-    _guard_output(args.json, args.recording, args.model)
-    ev = evaluate(read_recording(args.recording, _columns(args.columns)), load_model(args.model))
-    print(f"rms force residual {ev['rms_force']:.4g} N, nrmse {ev['nrmse_force']:.4g}")
+    _check_outputs({"RECORDING": args.recording, "--model": args.model}, {"--json": args.json})
+    model = load_model(args.model)
+    ev = evaluate(_read(args, args.recording), model)
+    print(f"rms force residual {ev['rms_force']:.4g} N, nrmse {100 * ev['nrmse_force']:.3g} %")
     _write_json(args.json, ev)
     print(f"evaluation written to {args.json}")
     return 0
 
 
 def _cmd_fit(args: argparse.Namespace) -> int:
-    from .diagnosis import diagnose, evaluate, fit_inverse_dynamics
-    from .io import read_recording
+    from .diagnosis import evaluate, fit_inverse_dynamics, fit_model
     from .model import save_model
 
-    _guard_output(args.json, args.recording)
-    rec = read_recording(args.recording, _columns(args.columns))
+    effects = [e.strip() for e in (args.effects or "").split(",") if e.strip()]
+
+    _check_outputs({"RECORDING": args.recording}, {"--json": args.json, "--html": args.html})
+    rec = _read(args, args.recording)
     if rec.F is None and args.force_constant is None:
-        raise InputError.at("--force-constant", f"{args.recording} holds the current i: give "
-                            "the force constant K_F [N/A] with --force-constant")
-    model = fit_inverse_dynamics(rec, mass=args.mass, force_constant=args.force_constant or 1.0)
-    before = evaluate(rec, model)["nrmse_force"]
+        raise UsageError.option("--force-constant", f"{args.recording} holds the current i: "
+                                "give the force constant K_F [N/A] with --force-constant")
+    pr = _progress(args)
+    with pr.step("inverse dynamics (robust least squares)"):
+        model = fit_inverse_dynamics(rec, mass=args.mass,
+                                     force_constant=args.force_constant or 1.0)
+        first = model
+        before = evaluate(rec, model)["nrmse_force"]
     print(f"inverse dynamics (robust least squares, static friction curve): force nrmse "
           f"{100 * before:.2f} %")
+    after = None
     if not args.no_refine:
         # refine every base parameter with the bristle state simulated along the measured
         # velocity (the diagnosis's base re-estimation, with no extra physics)
-        refined = diagnose(rec, model, candidates=[], free_mass=True).augmented_model()
-        if args.mass:
-            refined = refined.replace(axis={**refined.axis, "mass": args.mass})
-        after = evaluate(rec, refined)["nrmse_force"]
+        with pr.step("refining with the simulated LuGre state"
+                     + (f" and {', '.join(effects)}" if effects else "")):
+            refined, dg = fit_model(rec, effects=effects, mass=args.mass,
+                                    force_constant=args.force_constant or 1.0)
+            after = evaluate(rec, refined)["nrmse_force"]
+        for f in dg.findings:
+            print(f"{f.effect}: " + ", ".join(f"{k} {v:.4g}" for k, v in f.parameters.items()
+                                               if isinstance(v, float)))
+        missing = [e for e in effects if e not in {f.effect for f in dg.findings}
+                   and not (e in ("delay", "current_lag")
+                            and {"delay", "current_lag"} & {f.effect for f in dg.findings})]
+        for e in missing:
+            print(f"{e}: not supported by this record (no consistent gain on held-out "
+                  "stretches); left out of the model", file=sys.stderr)
         print(f"refined with the LuGre state simulated along the measured velocity: force "
               f"nrmse {100 * after:.2f} %")
         if after < before:
@@ -169,104 +366,212 @@ def _cmd_fit(args: argparse.Namespace) -> int:
         p = getattr(model, d)
         print(f"{d:8s} fc {p['fc']:.4g} N  fs {p['fs']:.4g} N  sigma2 {p['sigma2']:.4g} N s/m  "
               f"vs {p['vs']:.4g} m/s")
-    print(f"mass {model.mass:.4g} kg, sigma0 {model.sigma0:.4g} N/m, sigma1 {model.sigma1:.4g} N s/m, "
-          f"force constant {model.force_constant:.4g} N/A")
+    print(f"mass {model.mass:.4g} kg, sigma0 {model.sigma0:.4g} N/m, sigma1 {model.sigma1:.4g} "
+          f"N s/m, force constant {model.force_constant:.4g} N/A")
+    page = None
+    if args.html:
+        from .html import fit_page
+
+        with pr.step("rendering the HTML page"):
+            page = fit_page(model.to_dict(), rec, source=args.recording,
+                            nrmse={"inverse dynamics": before, "refined": after},
+                            first=first.to_dict())
     save_model(model, args.json)
     print(f"model written to {args.json}")
+    if page is not None:
+        _write_text(args.html, page)
+        print(f"page written to {args.html}")
     return 0
 
 
 def _cmd_paper(args: argparse.Namespace) -> int:
+    import json
+
     from .paper import run_paper
 
-    run_paper(args.out, seed=args.seed, monte_carlo=args.monte_carlo)
+    _check_outputs({}, {"--html": args.html}, {"--out": args.out})
+    with _progress(args).step("rerunning the paper's experiments"):
+        result = run_paper(args.out, seed=args.seed, monte_carlo=args.monte_carlo)
+    if args.html:
+        from .html import paper_page
+
+        written = Path(args.out) / "paper.json"
+        doc = json.loads(written.read_text()) if written.is_file() else result
+        _write_text(args.html, paper_page(doc))
+        print(f"page written to {args.html}")
     return 0
+
+
+# --------------------------------------------------------------------------------------
+# Parser
+# --------------------------------------------------------------------------------------
+
+
+class _Parser(argparse.ArgumentParser):
+    """Usage errors in one line, with where to read more (exit status 2)."""
+
+    def error(self, message: str) -> Any:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+class _Formatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
+    """Defaults in the help (where there is one to state), examples kept as written."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        if action.default in (None, False) or action.default is argparse.SUPPRESS:
+            return action.help
+        return super()._get_help_string(action)
+
+
+_EXAMPLES = {
+    "demo": "lugre demo --out figures/",
+    "fit-static": "lugre fit-static points.csv --json static.json --plot static.png\n"
+                  "  lugre fit-static plateaus.csv --force-constant 25 --json static.json",
+    "fit-dynamic": "lugre fit-dynamic closed_loop.csv --model static.json --json model.json",
+    "diagnose": "lugre diagnose recording.csv --model model.json --holdout second_run.csv \\\n"
+                "      --json report.json --html report.html --out-model augmented.json",
+    "evaluate": "lugre evaluate recording.csv --model model.json --json eval.json",
+    "fit": "lugre fit recording.csv --force-constant 25 --json model.json --html fit.html\n"
+           "  lugre fit DATA_EMPS.mat --columns 'x=qm,x_ref=qg,F=gtau*vir' --json emps.json",
+    "paper": "lugre paper --out paper/ --html paper.html",
+}
+
+
+def _add(sub: Any, name: str, help: str, common: list[argparse.ArgumentParser]) -> Any:
+    return sub.add_parser(name, help=help, description=help[0].upper() + help[1:] + ".",
+                          epilog="example:\n  " + _EXAMPLES[name], formatter_class=_Formatter,
+                          parents=common)
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand."""
-    p = argparse.ArgumentParser(
+    from . import __version__
+
+    p = _Parser(
         prog="lugre",
         description="LuGre friction: simulate servo axes, identify friction, diagnose mismatch.",
+        epilog="examples:\n  " + "\n  ".join(_EXAMPLES[k] for k in ("fit", "diagnose")),
+        formatter_class=_Formatter,
     )
+    p.add_argument("--version", action="version", version=f"lugre {__version__}")
+    quiet = _Parser(add_help=False)
+    quiet.add_argument("-q", "--quiet", action="store_true",
+                       help="no progress lines on stderr (they appear only on a terminal)")
+    common = [quiet]
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
-    d = sub.add_parser("demo", help="simulate the seed paper's axis (stick-slip, speed tracking)"
-                       " and save plots")
+    d = _add(sub, "demo", "simulate the seed paper's axis (stick-slip, speed tracking) and "
+             "save plots", common)
     d.add_argument("--out", default="lugre-demo", help="directory for the PNG figures")
     d.set_defaults(func=_cmd_demo)
 
-    w = {"choices": ["igg", "huber", "tukey", "none"], "default": "igg",
-         "help": "robust weights (default: igg, as in the seed paper; none = least squares)"}
-    c = {"default": None, "metavar": "MAP",
-         "help": "column mapping for other names, e.g. 'x=qm,F=gtau*vir'"}
-    fs = sub.add_parser("fit-static", help="Stribeck parameters per direction from "
-                        "steady-state points (v,F) or a raw constant-velocity record")
+    w: dict[str, Any] = {"choices": ["igg", "huber", "tukey", "none"], "default": "igg",
+         "help": "robust weights (igg as in the seed paper; none = least squares)"}
+    c: dict[str, Any] = {"default": None, "metavar": "MAP",
+         "help": "column mapping for other names or units, e.g. 'x=qm,F=gtau*vir' or "
+                 "'x=pos/1000'"}
+
+    def recording_options(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("--columns", **c)
+        sp.add_argument("--x-unit", choices=["m", "mm", "um", "cm"], default="m",
+                        help="unit of the recorded positions (and speeds per second); "
+                             "converted to m")
+        sp.add_argument("--resample", action="store_true",
+                        help="interpolate linearly onto a uniform time grid when the "
+                             "sampling has gaps (said in the output)")
+
+    fs = _add(sub, "fit-static", "Stribeck parameters per direction from steady-state "
+              "points (v,F) or a raw constant-velocity record", common)
     fs.add_argument("data", metavar="POINTS_OR_RECORDING")
     fs.add_argument("--json", required=True, metavar="MODEL.json", help="model to write")
     fs.add_argument("--model", metavar="BASE.json",
-                    help="take axis, sigma0, sigma1, effects and controller from this model")
-    fs.add_argument("--force-constant", type=float, help="K_F [N/A] for a record of currents")
-    fs.add_argument("--mass", type=float, help="moving mass [kg] to write into the model")
+                    help="take axis, sigma0, sigma1, effects and controller from this model "
+                         "(without it the seed paper's values are placeholders)")
+    fs.add_argument("--force-constant", type=_POSITIVE,
+                    help="K_F [N/A] for a record of currents")
+    fs.add_argument("--mass", type=_POSITIVE, help="moving mass [kg] to write into the model")
     fs.add_argument("--weighting", **w)
-    fs.add_argument("--columns", **c)
-    fs.add_argument("--chunks", type=int, default=3,
-                    help="points per settled plateau of a raw record (default 3)")
+    recording_options(fs)
+    fs.add_argument("--chunks", type=_COUNT, default=3,
+                    help="points per settled plateau of a raw record")
     fs.add_argument("--plot", metavar="PNG", help="write a figure of the fit")
+    fs.add_argument("--html", metavar="PAGE.html", help="write a self-contained HTML page")
     fs.set_defaults(func=_cmd_fit_static)
 
-    fd = sub.add_parser("fit-dynamic", help="sigma0 and sigma1 from a closed-loop record "
-                        "(with x_ref) under the model's controller, static sets held")
+    fd = _add(sub, "fit-dynamic", "sigma0 and sigma1 from a closed-loop record (with x_ref) "
+              "under the model's controller, static sets held", common)
     fd.add_argument("recording", metavar="RECORDING")
-    fd.add_argument("--model", required=True, metavar="STATIC.json")
-    fd.add_argument("--json", required=True, metavar="MODEL.json")
+    fd.add_argument("--model", required=True, metavar="STATIC.json",
+                    help="model with the static sets and the controller")
+    fd.add_argument("--json", required=True, metavar="MODEL.json", help="model to write")
     fd.add_argument("--weighting", **w)
-    fd.add_argument("--c1", type=float, default=1.0, help="weight of sum(e^2) (eq. 18)")
-    fd.add_argument("--c2", type=float, default=0.0, help="weight of max|e| (eq. 18)")
-    fd.add_argument("--resolution", type=float, default=0.0,
+    fd.add_argument("--c1", type=_NONNEGATIVE, default=1.0,
+                    help="weight of sum(e^2) (eq. 18)")
+    fd.add_argument("--c2", type=_NONNEGATIVE, default=0.0, help="weight of max|e| (eq. 18)")
+    fd.add_argument("--resolution", type=_NONNEGATIVE, default=0.0,
                     help="encoder resolution [m]: lower bound of the residual scale")
-    fd.add_argument("--columns", **c)
+    recording_options(fd)
     fd.set_defaults(func=_cmd_fit_dynamic)
 
-    dg = sub.add_parser("diagnose", help="locate where the model misses the recording, name "
-                        "the missing physics, refit, and show the gain on held-out data")
+    dg = _add(sub, "diagnose", "locate where the model misses the recording, name the "
+              "missing physics, refit, and show the gain on held-out data", common)
     dg.add_argument("recording", metavar="RECORDING")
-    dg.add_argument("--model", required=True, metavar="MODEL.json")
+    dg.add_argument("--model", required=True, metavar="MODEL.json",
+                    help="the model the recording is checked against")
     dg.add_argument("--holdout", metavar="RECORDING2", help="a second run for validation")
-    dg.add_argument("--json", required=True, metavar="REPORT.json")
+    dg.add_argument("--json", required=True, metavar="REPORT.json", help="report to write")
     dg.add_argument("--out-model", metavar="AUGMENTED.json",
                     help="the model with the findings added to its effects")
+    dg.add_argument("--html", metavar="REPORT.html",
+                    help="a self-contained page: verdict, findings with figures")
     dg.add_argument("--plots", metavar="DIR", help="PNG directory (default: REPORT_plots/)")
-    dg.add_argument("--columns", **c)
+    dg.add_argument("--screw-lead", type=_POSITIVE, metavar="M",
+                    help="ball-screw lead [m] (one revolution): its pitch and harmonics are "
+                         "always tried for a position-periodic force (default: the model's "
+                         "axis.screw_lead)")
+    recording_options(dg)
     dg.set_defaults(func=_cmd_diagnose)
 
-    ev = sub.add_parser("evaluate", help="rms and normalised rms of the inverse-dynamics force "
-                        "residual of a model on a recording")
+    ev = _add(sub, "evaluate", "rms and normalised rms of the inverse-dynamics force "
+              "residual of a model on a recording", common)
     ev.add_argument("recording", metavar="RECORDING")
-    ev.add_argument("--model", required=True, metavar="MODEL.json")
-    ev.add_argument("--json", required=True, metavar="EVAL.json")
-    ev.add_argument("--columns", **c)
+    ev.add_argument("--model", required=True, metavar="MODEL.json", help="the model")
+    ev.add_argument("--json", required=True, metavar="EVAL.json",
+                    help="evaluation to write (rms_force [N], nrmse_force)")
+    recording_options(ev)
     ev.set_defaults(func=_cmd_evaluate)
 
-    ft = sub.add_parser("fit", help="identify mass and LuGre friction from any recording with "
-                        "motion in both directions (robust inverse dynamics)")
+    ft = _add(sub, "fit", "identify mass and LuGre friction from any recording with motion "
+              "in both directions (robust inverse dynamics)", common)
     ft.add_argument("recording", metavar="RECORDING")
-    ft.add_argument("--json", required=True, metavar="MODEL.json")
-    ft.add_argument("--mass", type=float, help="known moving mass [kg] (estimated otherwise)")
-    ft.add_argument("--force-constant", type=float,
+    ft.add_argument("--json", required=True, metavar="MODEL.json", help="model to write")
+    ft.add_argument("--mass", type=_POSITIVE,
+                    help="known moving mass [kg] (estimated otherwise)")
+    ft.add_argument("--force-constant", type=_POSITIVE,
                     help="K_F [N/A]; needed when the recording holds the current i")
+    ft.add_argument("--effects", metavar="E1,E2",
+                    help="effects of the vocabulary to identify with the base from the start, "
+                         "e.g. resonance,drag (each kept only if the record supports it)")
     ft.add_argument("--no-refine", action="store_true",
                     help="stop after the inverse-dynamics least squares")
-    ft.add_argument("--columns", **c)
+    ft.add_argument("--html", metavar="PAGE.html", help="write a self-contained HTML page")
+    recording_options(ft)
     ft.set_defaults(func=_cmd_fit)
 
-    pp = sub.add_parser("paper", help="rerun the seed paper's experiments (Tables 1 and 2, "
-                        "speed tracking) beside its numbers, with PNG figures")
+    pp = _add(sub, "paper", "rerun the seed paper's experiments (Tables 1 and 2, speed "
+              "tracking) beside its numbers, with PNG figures", common)
     pp.add_argument("--out", default="lugre-paper", help="directory for the figures")
     pp.add_argument("--seed", type=int, default=1, help="random seed of the synthetic data")
-    pp.add_argument("--monte-carlo", type=int, default=40,
+    pp.add_argument("--monte-carlo", type=_COUNT0, default=40,
                     help="static datasets for the Monte Carlo summary (0 to skip)")
+    pp.add_argument("--html", metavar="PAGE.html", help="the tables as a self-contained page")
     pp.set_defaults(func=_cmd_paper)
     return p
+
+
+def _show_warning(message: Any, category: Any, filename: str, lineno: int,
+                  file: Any = None, line: Any = None) -> None:
+    text = " ".join(str(message).split())
+    print(f"warning: {text}", file=sys.stderr)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -276,18 +581,28 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
-    try:
-        return int(args.func(args))
-    except (LugreError, FileNotFoundError, IsADirectoryError, PermissionError) as e:
-        print(f"lugre {args.command}: error: {e}", file=sys.stderr)
-        return 1
-    except BrokenPipeError:
-        # the reader of our output went away (e.g. `| head`): not an error of ours
-        sys.stdout = open(os.devnull, "w")  # noqa: SIM115
-        return 0
-    except KeyboardInterrupt:
-        print(f"lugre {args.command}: interrupted", file=sys.stderr)
-        return 130
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")
+        warnings.showwarning = _show_warning
+        try:
+            return int(args.func(args))
+        except UsageError as e:
+            print(f"lugre {args.command}: error: {e}", file=sys.stderr)
+            return 2
+        except (LugreError, FileNotFoundError, IsADirectoryError, PermissionError) as e:
+            msg = str(e)
+            if isinstance(e, OSError) and e.strerror:
+                name = os.fsdecode(e.filename) if e.filename else ""
+                msg = e.strerror if name in e.strerror else f"{name}: {e.strerror}"
+            print(f"lugre {args.command}: error: {msg}", file=sys.stderr)
+            return 1
+        except BrokenPipeError:
+            # the reader of our output went away (e.g. `| head`): not an error of ours
+            sys.stdout = open(os.devnull, "w")  # noqa: SIM115
+            return 0
+        except KeyboardInterrupt:
+            print(f"lugre {args.command}: interrupted", file=sys.stderr)
+            return 130
 
 
 if __name__ == "__main__":

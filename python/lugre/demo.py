@@ -18,7 +18,7 @@ import numpy as np
 
 from ._native import simulate
 from .model import Model
-from .plots import figure, label_axes, save_png
+from .plots import figure, label_axes, legend_above, save_png
 
 __all__ = ["DemoResult", "run_demo"]
 
@@ -78,13 +78,13 @@ def run_demo(out_dir: str | os.PathLike[str], verbose: bool = True) -> DemoResul
     ax = ax[:, 0]
     ax[0].plot(t, 1e3 * x_ref, "k--", lw=1, label="reference")
     ax[0].plot(t, 1e3 * r.x, lw=1.2, label="position")
-    ax[0].legend(loc="upper left")
+    legend_above(ax[0])
     ax[1].plot(t, 1e3 * r.v, lw=1)
     ax[2].plot(t, r.friction, lw=1, label="LuGre friction")
     ax[2].plot(t, 25.0 * r.i, lw=0.8, alpha=0.7, label="motor force")
-    ax[2].legend(loc="lower right")
+    legend_above(ax[2])
     label_axes(ax, ["x [mm]", "v [mm/s]", "force [N]"], "t [s]")
-    ax[0].set_title("Stick-slip: 10 mm/s ramp pulled through a soft position loop")
+    ax[0].set_title("Stick-slip: 10 mm/s ramp pulled through a soft position loop", pad=20)
     f1 = save_png(fig, os.path.join(out_dir, "stick_slip.png"))
     say(f"stick-slip: the speed fell below 1 mm/s {stops} times after t = 1 s, peak slip speed "
         f"{1e3 * r.v[late].max():.1f} mm/s (ramp 10 mm/s) -> {f1}")
@@ -99,15 +99,17 @@ def run_demo(out_dir: str | os.PathLike[str], verbose: bool = True) -> DemoResul
     m0, m1 = float(np.abs(e0[second]).max()), float(np.abs(e1[second]).max())
     fig, ax = figure(2, 1, figsize=(9, 5.5))
     ax = ax[:, 0]
-    ax[0].plot(t, v_ref, "k--", lw=1, label="reference")
-    ax[0].plot(t, plain.v, lw=1, label="no compensation")
-    ax[0].plot(t, comp.v, lw=1, label="LuGre feed-forward")
-    ax[0].legend(loc="upper right")
-    ax[1].plot(t, 100 * e0, lw=1, label=f"no compensation (max {100 * m0:.1f} cm/s)")
-    ax[1].plot(t, 100 * e1, lw=1, label=f"LuGre feed-forward (max {100 * m1:.1f} cm/s)")
-    ax[1].legend(loc="upper right")
-    label_axes(ax, ["v [m/s]", "error [cm/s]"], "t [s]")
-    ax[0].set_title("Speed tracking of sin(2 pi t) m/s, PI speed loop (1200, 12000) at 10 kHz")
+    # one unit per quantity across the figures: speeds in mm/s
+    ax[0].plot(t, 1e3 * v_ref, "k--", lw=1, label="reference")
+    ax[0].plot(t, 1e3 * plain.v, lw=1, label="no compensation")
+    ax[0].plot(t, 1e3 * comp.v, lw=1, label="LuGre feed-forward")
+    legend_above(ax[0])
+    ax[1].plot(t, 1e3 * e0, lw=1, label=f"no compensation (max {1e3 * m0:.0f} mm/s)")
+    ax[1].plot(t, 1e3 * e1, lw=1, label=f"LuGre feed-forward (max {1e3 * m1:.0f} mm/s)")
+    legend_above(ax[1], ncol=2)
+    label_axes(ax, ["v [mm/s]", "speed error [mm/s]"], "t [s]")
+    ax[0].set_title("Speed tracking of sin(2 pi t) m/s, PI speed loop (1200, 12000) at 10 kHz",
+                    pad=20)
     f2 = save_png(fig, os.path.join(out_dir, "speed_tracking.png"))
     say(f"speed tracking: max error {100 * m0:.1f} cm/s without compensation, "
         f"{100 * m1:.1f} cm/s with LuGre feed-forward (paper: about 18, then below 10) -> {f2}")

@@ -812,9 +812,9 @@ def _as_model(m: ModelLike) -> Model:
         return Model(m)
     if isinstance(m, (str, os.PathLike)):
         return load_model(m)
-    raise TypeError(
-        f"expected a lugre.Model, a model dict or the path of a model JSON file, "
-        f"got {type(m).__name__}"
+    raise ModelError.at(
+        "model", f"got {type(m).__name__}: give a lugre.Model, a model dict or the path "
+        "of a model JSON file (e.g. lugre.Model.paper() or lugre.load_model('model.json'))"
     )
 
 
@@ -872,7 +872,7 @@ def save_model(model: ModelLike, path: str | os.PathLike[str]) -> None:
     path : str or os.PathLike
         Destination file.
     """
-    from .io import _atomic_write
+    from ._atomic import _atomic_write
 
     m = _as_model(model)
     text = m.to_json(indent=2) + "\n"

@@ -17,8 +17,8 @@ def write_plots(diagnosis: Diagnosis, out_dir: str | os.PathLike[str]) -> list[P
 
     Files: ``residual_time.png``, ``residual_position.png``, ``residual_velocity.png``
     (residual before and after, with the noise floor), ``residual_spectrum.png``
-    (spectrum of the residual over position), ``overlay.png`` (measured motor force
-    against the model before and after).
+    (spectrum of the residual over position), ``overlay.png`` (the force residual
+    before and after, over time). Positions in mm, speeds in mm/s; legends above the axes.
 
     Parameters
     ----------
@@ -38,6 +38,11 @@ def write_plots(diagnosis: Diagnosis, out_dir: str | os.PathLike[str]) -> list[P
     import matplotlib.pyplot as plt
 
     out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        from ..exceptions import InputError
+
+        raise InputError.at("out_dir", f"{out} exists and is not a directory: give a "
+                            "directory for the figures")
     out.mkdir(parents=True, exist_ok=True)
     d = diagnosis.data
     m = d["mask"]
@@ -51,48 +56,56 @@ def write_plots(diagnosis: Diagnosis, out_dir: str | os.PathLike[str]) -> list[P
         plt.close(fig)
         files.append(p)
 
-    for key, label, unit in (("t", "time", "s"), ("x", "position", "m"), ("v", "velocity", "m/s")):
+    # one unit per quantity across the figures: position in mm, speed in mm/s
+    for key, label, unit, scale in (("t", "time", "s", 1.0), ("x", "position", "mm", 1e3),
+                                    ("v", "velocity", "mm/s", 1e3)):
         fig, ax = plt.subplots(figsize=(8, 4))
         style = "-" if key == "t" else "."
         kw = {"lw": 0.6} if key == "t" else {"ms": 1}
-        ax.plot(d[key][m], d["before"][m], style, color="tab:red", alpha=0.6,
-                label="before", **kw)
-        ax.plot(d[key][m], d["after"][m], style, color="tab:blue", alpha=0.7,
-                label="after", **kw)
+        ax.plot(scale * d[key][m], d["before"][m], style, color="tab:red", alpha=0.6,
+                label="residual before", **kw)
+        ax.plot(scale * d[key][m], d["after"][m], style, color="tab:blue", alpha=0.7,
+                label="residual after", **kw)
         for s in (-2 * floor, 2 * floor):
             ax.axhline(s, color="k", ls="--", lw=0.8)
         ax.set_xlabel(f"{label} [{unit}]")
         ax.set_ylabel("force residual [N]")
-        ax.set_title(f"Residual against {label} (dashed: 2x noise floor)")
-        ax.legend(loc="upper right")
+        ax.set_title(f"Residual against {label} (dashed: 2x noise floor)", loc="left",
+                     pad=22)
+        _legend_above(ax)
         save(fig, f"residual_{label}.png")
 
     fig, ax = plt.subplots(figsize=(8, 4))
     k = d["spectrum_k"]
     with np.errstate(divide="ignore"):
-        ax.semilogy(1.0 / k * 1e3, d["spectrum_before"], color="tab:red", label="before")
-        ax.semilogy(1.0 / k * 1e3, d["spectrum_after"], color="tab:blue", label="after")
+        ax.semilogy(1.0 / k * 1e3, d["spectrum_before"], color="tab:red",
+                    label="residual before")
+        ax.semilogy(1.0 / k * 1e3, d["spectrum_after"], color="tab:blue",
+                    label="residual after")
     ax.set_xscale("log")
     ax.set_xlabel("pitch [mm]")
     ax.set_ylabel("amplitude [N]")
-    ax.set_title("Spectrum of the residual over position")
-    ax.legend()
+    ax.set_title("Spectrum of the residual over position", loc="left", pad=22)
+    _legend_above(ax)
     save(fig, "residual_spectrum.png")
 
-    fig, axs = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    # the models' forces lie on top of the measured force at this scale: show what they
+    # leave, the residual before and after
+    fig, ax = plt.subplots(figsize=(9, 4))
     t = d["t"]
-    axs[0].plot(t[m], d["force"][m], color="k", lw=0.8, label="measured motor force")
-    axs[0].plot(t[m], d["model_before"][m], color="tab:red", lw=0.6, label="model before")
-    axs[0].plot(t[m], d["model_after"][m], color="tab:blue", lw=0.6, label="model after")
-    axs[0].set_ylabel("force [N]")
-    axs[0].legend(loc="upper right")
+    ax.plot(t[m], d["before"][m], color="tab:red", lw=0.6, label="residual before")
+    ax.plot(t[m], d["after"][m], color="tab:blue", lw=0.6, label="residual after")
     fb, fa = diagnosis.fit["before"], diagnosis.fit["after"]
-    axs[0].set_title(f"Before/after: rms residual {fb['rms_force']:.3g} N -> "
-                     f"{fa['rms_force']:.3g} N")
-    axs[1].plot(t[m], d["before"][m], color="tab:red", lw=0.6, label="residual before")
-    axs[1].plot(t[m], d["after"][m], color="tab:blue", lw=0.6, label="residual after")
-    axs[1].set_xlabel("time [s]")
-    axs[1].set_ylabel("residual [N]")
-    axs[1].legend(loc="upper right")
+    ax.set_title(f"Force residual {fb['rms_force']:.3g} N -> {fa['rms_force']:.3g} N rms",
+                 loc="left", pad=22)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("force residual [N]")
+    _legend_above(ax)
     save(fig, "overlay.png")
     return files
+
+
+def _legend_above(ax: object) -> None:
+    """The legend above the axes, off the data."""
+    ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=3, frameon=False,  # type: ignore[attr-defined]
+              fontsize=8, borderaxespad=0.2)

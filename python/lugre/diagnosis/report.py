@@ -9,6 +9,8 @@ from typing import Any
 
 import numpy as np
 
+from .. import units as U
+from ..html import plain_text
 from ..model import Model
 
 __all__ = ["Diagnosis", "Finding"]
@@ -185,13 +187,16 @@ class Diagnosis:
             lines.append("Findings: none beyond noise.")
         for k, f in enumerate(self.findings, 1):
             ps = ", ".join(
-                f"{a}={_fmt(v)}" for a, v in f.parameters.items()
+                f"{a} {U.fmt(v, U.unit_of(f.effect, a))}" for a, v in f.parameters.items()
                 if a not in ("positions", "scale")
             )
-            wh = ", ".join(f"{a} {_fmt(v)}" for a, v in f.where.items() if v is not None)
-            lines.append(f"{k}. {f.effect} ({ps}) explains {100 * f.explained:.0f} % of "
-                         f"the residual{'; lives at ' + wh if wh else ''}.")
-            lines.append(f"   {f.evidence}")
+            wh = ", ".join(f"{a} {U.fmt_range(v[0], v[1], U.WHERE_UNITS.get(a, ('', 1.0)))}"
+                           if isinstance(v, (list, tuple)) and len(v) == 2 else f"{a} {_fmt(v)}"
+                           for a, v in f.where.items() if v is not None)
+            line = (f"{k}. {f.effect}{' (' + ps + ')' if ps else ''} explains {100 * f.explained:.0f} % of "
+                    f"the residual{'; lives at ' + wh if wh else ''}.")
+            lines.append(line.replace("\u2212", "-"))
+            lines.append(f"   {plain_text(f.evidence)}")
             for alt in f.alternatives:
                 lines.append(f"   Equally well: {alt['effect']} {_fmt(alt['parameters'])}. "
                              f"To separate: {alt['experiment']}")
