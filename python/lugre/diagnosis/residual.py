@@ -371,21 +371,9 @@ def bristles(v: np.ndarray, dt: float, model: Model, scale: np.ndarray | None,
     numpy.ndarray
         ``z[k]``, the state at ``t_k`` [m].
     """
-    if scale is None and exponent == 2.0:
-        fm = model.replace(effects=[]) if model.effects else model
-        return friction_force(v, dt, fm, return_z=True)[1]
-    s0 = float(model.friction["sigma0"])
-    g = _g(model, v, scale, exponent)
-    zss = np.sign(v) * g / s0
-    dec = np.exp(-s0 * np.abs(v) * dt / g)
-    zs = np.empty(v.size)
-    z = 0.0
-    zss_l = zss.tolist()
-    dec_l = dec.tolist()
-    for k in range(v.size):
-        zs[k] = z
-        z = zss_l[k] + (z - zss_l[k]) * dec_l[k]
-    return zs
+    shape = [] if exponent == 2.0 else [{"effect": "stribeck_shape", "exponent": exponent}]
+    fm = model.replace(effects=shape) if model.effects != shape else model
+    return friction_force(v, dt, fm, return_z=True, scale=scale)[1]
 
 
 def lugre_at(model: Model, v: np.ndarray, z: np.ndarray, scale: np.ndarray | None,
