@@ -10,8 +10,8 @@ written in NumPy alone, for checking and reading.
 
 from __future__ import annotations
 
-from ._native import friction_force, simulate, simulate_batch, stribeck
-from ._result import SimResult
+from ._native import friction_force, load_coupling, simulate, simulate_batch, stribeck
+from ._result import CouplingResult, SimResult
 from .diagnosis import Diagnosis, diagnose, evaluate, fit_inverse_dynamics
 from .exceptions import (
     ConvergenceWarning,
@@ -41,6 +41,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "ConvergenceWarning",
+    "CouplingResult",
     "DataError",
     "Diagnosis",
     "DynamicFit",
@@ -64,6 +65,7 @@ __all__ = [
     "fit_inverse_dynamics",
     "fit_static",
     "friction_force",
+    "load_coupling",
     "load_model",
     "read_points",
     "read_recording",
