@@ -126,8 +126,9 @@ def load_coupling(
 
     The load (``r*M``, carrying the friction and the effect forces) is simulated along
     the sampled motor position and velocity, interpolated linearly between samples, in
-    ``substeps*max(1, ceil(4*w*dt))`` substeps per interval with
-    ``w = sqrt((k + sigma0)/(r*M))`` (exact bristle update, semi-implicit Euler;
+    ``substeps*max(1, ceil(4*w*dt), ceil(d*dt))`` substeps per interval with
+    ``w = sqrt((k + sigma0)/(r*M))`` and ``d = (c + sigma1 + max(sigma2))/(r*M)``
+    (exact bristle update, semi-implicit Euler;
     ``docs/DESIGN.md``). With ``a_m`` the motor's acceleration, the model's motor force
     is ``(1 - r)*M*a_m + force``. Runs in the Rust core; the parameters and results are
     those of :func:`lugre.reference.load_coupling`.

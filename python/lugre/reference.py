@@ -851,8 +851,9 @@ def load_coupling(
     ``k = r*M*(2*pi*frequency)^2`` and a damper ``c = 2*damping_ratio*sqrt(k*r*M)``. The
     load starts at ``x[0]``, ``v[0]`` with ``z = z0`` and is driven by the motor position
     and velocity, interpolated linearly between samples, over
-    ``substeps*max(1, ceil(4*w*dt))`` equal substeps per interval,
-    ``w = sqrt((k + sigma0)/(r*M))``. Each substep (length ``h``), at its start:
+    ``substeps*max(1, ceil(4*w*dt), ceil(d*dt))`` equal substeps per interval,
+    ``w = sqrt((k + sigma0)/(r*M))``, ``d = (c + sigma1 + max(sigma2))/(r*M)``. Each
+    substep (length ``h``), at its start:
     ``F_s = k*(x_m - x_l) + c*(v_m - v_l)``, friction ``(g, F)`` at ``(z, v_l)`` with
     ``scale[k]`` and the model's Stribeck exponent,
     ``a_l = (F_s - F - extra[k])/(r*M)``; then the exact bristle update of ``z`` over
@@ -943,8 +944,10 @@ def load_coupling(
         _check_finite("extra", ex)
     kc, c, ml = tm.k, tm.c, tm.ml
     w = math.sqrt((kc + p.sigma0) / ml)
-    q = 4.0 * w * dtf
-    nsub_f = max(float(math.ceil(q)) if math.isfinite(q) else q, 1.0) * float(int(substeps))
+    d = (c + p.sigma1 + max(p.positive.sigma2, p.negative.sigma2)) / ml
+    q_stiff = 4.0 * w * dtf
+    q_damp = d * dtf
+    nsub_f = max(_ceil_f(q_stiff), _ceil_f(q_damp), 1.0) * float(int(substeps))
     if nsub_f > _MAX_COUPLING_SUBSTEPS:
         raise ParameterError.invalid(
             "dt", dtf,
@@ -996,6 +999,11 @@ def load_coupling(
             )
     return CouplingResult(*(np.array(a, dtype=np.float64)
                             for a in (out_f, out_x, out_v, out_z)))
+
+
+def _ceil_f(q: float) -> float:
+    """``f64::ceil`` (``math.ceil`` returns an int and fails on inf)."""
+    return float(math.ceil(q)) if math.isfinite(q) else q
 
 
 def _finite_option_any(name: str, value: Any) -> float:

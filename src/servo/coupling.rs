@@ -124,10 +124,24 @@ impl Coupling {
         ((self.k + self.friction.sigma0) / self.ml).sqrt()
     }
 
+    /// `d = (c + sigma1 + max(sigma2))/(r*M)` [1/s]: the strongest damping of the load
+    /// (coupling plus stuck bristles plus viscous friction), taken explicitly.
+    pub fn damping_rate(&self) -> f64 {
+        let s2 = self
+            .friction
+            .positive
+            .sigma2
+            .max(self.friction.negative.sigma2);
+        (self.c + self.friction.sigma1 + s2) / self.ml
+    }
+
     /// Substeps per sample interval before the `substeps` multiplier:
-    /// `max(1, ceil(4*w*dt))`, as a float (checked against [`MAX_SUBSTEPS`]).
+    /// `max(1, ceil(4*w*dt), ceil(d*dt))`, as a float (checked against
+    /// [`MAX_SUBSTEPS`]): `w*h <= 1/4` and `d*h <= 1`.
     pub fn auto_substeps(&self, dt: f64) -> f64 {
-        (4.0 * self.stiff_rate() * dt).ceil().max(1.0)
+        let stiff = (4.0 * self.stiff_rate() * dt).ceil();
+        let damp = (self.damping_rate() * dt).ceil();
+        stiff.max(damp).max(1.0)
     }
 
     #[inline(always)]
@@ -346,6 +360,31 @@ mod tests {
         );
         let r = load_coupling(&m, &[], &[], 1e-4, &o).unwrap();
         assert!(r.force.is_empty());
+    }
+
+    #[test]
+    fn heavy_damping_at_coarse_sampling_stays_stable() {
+        // damping_ratio 20 sampled at 1 kHz: d*dt = 5.6, so 6 substeps (the stiffness
+        // alone would give 1, which diverges)
+        let mut m = model();
+        m.effects[0] = Effect::Resonance {
+            frequency_hz: 22.0,
+            damping_ratio: 20.0,
+            load_fraction: 0.75,
+        };
+        let cp = Coupling::from_model(&m).unwrap();
+        assert_eq!((4.0 * cp.stiff_rate() * 1e-3).ceil(), 1.0);
+        assert_eq!(cp.auto_substeps(1e-3), 6.0);
+        let dt = 1e-3;
+        let w = 2.0 * core::f64::consts::PI * 2.0;
+        let x: Vec<f64> = (0..2000)
+            .map(|k| 0.01 * (w * k as f64 * dt).sin())
+            .collect();
+        let v: Vec<f64> = (0..2000)
+            .map(|k| 0.01 * w * (w * k as f64 * dt).cos())
+            .collect();
+        let r = load_coupling(&m, &x, &v, dt, &CouplingOptions::default()).unwrap();
+        assert!(r.force.iter().all(|f| f.abs() < 100.0));
     }
 
     #[test]
