@@ -11,7 +11,9 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use lugre::friction::{friction_force_into, LugreParams, StaticSet};
-use lugre::servo::{simulate, simulate_batch, Drive, Model, SimOptions};
+use lugre::servo::{
+    load_coupling, simulate, simulate_batch, CouplingOptions, Drive, Effect, Model, SimOptions,
+};
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -139,6 +141,31 @@ fn friction(c: &mut Criterion) {
     g.finish();
 }
 
+/// `load_coupling` (the load behind a `resonance` driven by the motor motion) over
+/// 20,000 samples at 10 kHz, the size of a diagnosis record.
+fn coupling(c: &mut Criterion) {
+    let mut m = Model::paper();
+    m.effects.push(Effect::Resonance {
+        frequency_hz: 22.0,
+        damping_ratio: 0.04,
+        load_fraction: 0.75,
+    });
+    let n = 20_000;
+    let dt = 1e-4;
+    let w = 2.0 * std::f64::consts::PI * 2.0;
+    let x: Vec<f64> = (0..n).map(|k| 0.01 * (w * k as f64 * dt).sin()).collect();
+    let v: Vec<f64> = (0..n)
+        .map(|k| 0.01 * w * (w * k as f64 * dt).cos())
+        .collect();
+    let opts = CouplingOptions::default();
+    let mut g = c.benchmark_group("load_coupling");
+    g.throughput(Throughput::Elements(n as u64));
+    g.bench_function(BenchmarkId::new("samples", n), |b| {
+        b.iter(|| load_coupling(&m, black_box(&x), black_box(&v), dt, &opts).unwrap())
+    });
+    g.finish();
+}
+
 /// Eight models of one batch on 1 and on 2 worker threads.
 fn batch(c: &mut Criterion) {
     let base = Model::paper();
@@ -172,6 +199,6 @@ criterion_group! {
     config = Criterion::default()
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(3));
-    targets = closed_loop, friction, batch
+    targets = closed_loop, friction, coupling, batch
 }
 criterion_main!(benches);

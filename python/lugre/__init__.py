@@ -17,8 +17,8 @@ from __future__ import annotations
 from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
-from ._native import friction_force, simulate, simulate_batch, stribeck
-from ._result import SimResult
+from ._native import friction_force, load_coupling, simulate, simulate_batch, stribeck
+from ._result import CouplingResult, SimResult
 from .exceptions import (
     ConvergenceWarning,
     DataError,
@@ -132,6 +132,7 @@ def steady_state_points(recording: Any, *args: Any, **kwargs: Any) -> Any:
 
 __all__ = [
     "ConvergenceWarning",
+    "CouplingResult",
     "DataError",
     "Diagnosis",
     "DynamicFit",
@@ -155,6 +156,7 @@ __all__ = [
     "fit_inverse_dynamics",
     "fit_static",
     "friction_force",
+    "load_coupling",
     "load_model",
     "read_points",
     "read_recording",

@@ -11,6 +11,7 @@ __all__ = [
     "fit_dynamic_record",
     "fit_static_points",
     "friction_force",
+    "load_coupling",
     "num_threads",
     "plateaus",
     "simulate",
@@ -30,6 +31,21 @@ def friction_force(
     return_z: bool = False,
     scale: npt.NDArray[np.float64] | None = None,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+def load_coupling(
+    x: npt.NDArray[np.float64],
+    v: npt.NDArray[np.float64],
+    dt: float,
+    model_json: str,
+    scale: npt.NDArray[np.float64] | None = None,
+    extra: npt.NDArray[np.float64] | None = None,
+    z0: float = 0.0,
+    substeps: int = 1,
+) -> tuple[
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+]: ...
 def simulate(
     model_json: str,
     t: npt.NDArray[np.float64],

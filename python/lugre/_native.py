@@ -13,12 +13,12 @@ from typing import Any
 import numpy as np
 
 from . import _core
-from ._result import SimResult
+from ._result import CouplingResult, SimResult
 from .exceptions import InputError
 from .model import ModelLike, _as_model
 from .reference import _check_substeps_type, _select_drive
 
-__all__ = ["friction_force", "simulate", "simulate_batch", "stribeck"]
+__all__ = ["friction_force", "load_coupling", "simulate", "simulate_batch", "stribeck"]
 
 
 def _array(name: str, a: Any) -> np.ndarray:
@@ -109,6 +109,74 @@ def friction_force(
         raise InputError.at("dt", f"must be a number or an array of numbers ({e})") from None
     f, z = _core.friction_force(vv, dta, _json(model), _float("z0", z0), bool(return_z), sc)
     return (f, z) if return_z else f
+
+
+def load_coupling(
+    x: Any,
+    v: Any,
+    dt: float,
+    model: ModelLike,
+    *,
+    scale: Any = None,
+    extra: Any = None,
+    z0: float = 0.0,
+    substeps: int = 1,
+) -> CouplingResult:
+    """The load behind the ``resonance`` coupling, driven by the measured motor motion.
+
+    The load (``r*M``, carrying the friction and the effect forces) is simulated along
+    the sampled motor position and velocity, interpolated linearly between samples, in
+    ``substeps*max(1, ceil(4*w*dt), ceil(d*dt))`` substeps per interval with
+    ``w = sqrt((k + sigma0)/(r*M))`` and ``d = (c + sigma1 + max(sigma2))/(r*M)``
+    (exact bristle update, semi-implicit Euler;
+    ``docs/DESIGN.md``). With ``a_m`` the motor's acceleration, the model's motor force
+    is ``(1 - r)*M*a_m + force``. Runs in the Rust core; the parameters and results are
+    those of :func:`lugre.reference.load_coupling`.
+
+    Parameters
+    ----------
+    x, v : array_like
+        Motor position [m] and velocity [m/s] at uniform samples, 1-D, same length.
+    dt : float
+        Sample interval [s], > 0.
+    model : Model, dict or path
+        The model; it must hold a ``resonance`` effect.
+    scale : array_like, optional
+        One positive factor per sample multiplying ``g(v)`` (``position_friction``,
+        ``drift``).
+    extra : array_like, optional
+        Further force on the load per sample [N] (cogging, springs, offsets, drag).
+    z0 : float, default 0.0
+        Initial bristle deflection [m].
+    substeps : int, default 1
+        Multiplier (>= 1) of the automatic number of substeps per interval.
+
+    Returns
+    -------
+    CouplingResult
+        Named tuple ``(force, x_load, v_load, z)`` at each sample (state before the
+        step that follows it): coupling force on the load [N], load position [m],
+        load velocity [m/s], bristle deflection [m].
+
+    Examples
+    --------
+    >>> import numpy as np, lugre
+    >>> d = lugre.Model.paper().to_dict()
+    >>> d["effects"] = [{"effect": "resonance", "frequency": 22.0, "damping_ratio": 0.04,
+    ...                  "load_fraction": 0.75}]
+    >>> r = lugre.load_coupling(np.zeros(5), np.zeros(5), 1e-4, d)
+    >>> float(np.abs(r.force).max())
+    0.0
+    """
+    mj = _json(model)
+    xx = _array("x", x)
+    vv = _array("v", v)
+    sc = None if scale is None else _array("scale", scale)
+    ex = None if extra is None else _array("extra", extra)
+    dtf = _float("dt", dt)
+    n_sub = _substeps(substeps)
+    f, xl, vl, z = _core.load_coupling(xx, vv, dtf, mj, sc, ex, _float("z0", z0), n_sub)
+    return CouplingResult(f, xl, vl, z)
 
 
 def _float(name: str, value: Any) -> float:

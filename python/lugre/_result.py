@@ -1,13 +1,14 @@
-"""The result of a simulation, shared by :mod:`lugre` (Rust core) and :mod:`lugre.reference`."""
+"""Results shared by :mod:`lugre` (Rust core) and :mod:`lugre.reference`: a simulation's
+:class:`SimResult` and :func:`~lugre.load_coupling`'s :class:`CouplingResult`."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
-__all__ = ["SimResult"]
+__all__ = ["CouplingResult", "SimResult"]
 
 
 class SimResult:
@@ -117,3 +118,26 @@ class SimResult:
 
     def __reduce__(self) -> tuple[Any, ...]:
         return (SimResult, tuple(getattr(self, k) for k in self.fields))
+
+
+class CouplingResult(NamedTuple):
+    """The load behind a ``resonance`` coupling at the sample instants
+    (:func:`lugre.load_coupling`); a tuple ``(force, x_load, v_load, z)``.
+
+    Attributes
+    ----------
+    force : numpy.ndarray
+        Force the coupling passes to the load, ``k*(x - x_load) + c*(v - v_load)`` [N];
+        the motor needs ``(1 - r)*M*a_m + force``.
+    x_load : numpy.ndarray
+        Load position [m].
+    v_load : numpy.ndarray
+        Load velocity [m/s].
+    z : numpy.ndarray
+        Bristle deflection of the load's friction [m].
+    """
+
+    force: np.ndarray
+    x_load: np.ndarray
+    v_load: np.ndarray
+    z: np.ndarray

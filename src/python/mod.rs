@@ -5,7 +5,7 @@ use crate::error::{check_finite, Error};
 use crate::friction::{
     friction_force_general_into, friction_force_into, friction_force_varstep_into,
 };
-use crate::servo::{self, Drive, Integrator, Model, SimOptions, SimResult};
+use crate::servo::{self, CouplingOptions, Drive, Integrator, Model, SimOptions, SimResult};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
@@ -32,10 +32,19 @@ pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
                 Ok(inst) => PyErr::from_value(inst),
                 Err(err) => err,
             };
-            if let Error::Parameter { name, value, .. } = &e {
-                let inst = err.value(py);
-                let _ = inst.setattr("name", name.as_str());
-                let _ = inst.setattr("value", *value);
+            let inst = err.value(py);
+            match &e {
+                Error::Parameter { name, value, .. } => {
+                    let _ = inst.setattr("name", name.as_str());
+                    let _ = inst.setattr("value", *value);
+                }
+                Error::Input { name, .. } => {
+                    let _ = inst.setattr("name", name.as_str());
+                }
+                Error::Model { path, .. } => {
+                    let _ = inst.setattr("path", path.as_str());
+                }
+                _ => {}
             }
             err
         }
@@ -173,6 +182,58 @@ fn friction_force<'py>(
         (f, z)
     });
     Ok((f.into_pyarray(py), z.into_pyarray(py)))
+}
+
+type ArrayQuad<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+);
+
+/// The load behind the `resonance` coupling driven by the motor motion `x`, `v`;
+/// returns `(force, x_load, v_load, z)` at the samples.
+#[pyfunction]
+#[pyo3(signature = (x, v, dt, model_json, scale=None, extra=None, z0=0.0, substeps=1))]
+#[allow(clippy::too_many_arguments)]
+fn load_coupling<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    v: PyReadonlyArray1<'py, f64>,
+    dt: f64,
+    model_json: &str,
+    scale: Option<PyReadonlyArray1<'py, f64>>,
+    extra: Option<PyReadonlyArray1<'py, f64>>,
+    z0: f64,
+    substeps: usize,
+) -> PyResult<ArrayQuad<'py>> {
+    let m = parse_model(py, model_json)?;
+    let r = (|| -> Result<servo::LoadTrajectory, Error> {
+        let xs = slice("x", &x)?;
+        let vs = slice("v", &v)?;
+        let sc = match &scale {
+            None => None,
+            Some(a) => Some(slice("scale", a)?),
+        };
+        let ex = match &extra {
+            None => None,
+            Some(a) => Some(slice("extra", a)?),
+        };
+        let opts = CouplingOptions {
+            scale: sc,
+            extra: ex,
+            z0,
+            substeps,
+        };
+        py.detach(|| servo::load_coupling(&m, xs, vs, dt, &opts))
+    })()
+    .map_err(|e| to_py(py, e))?;
+    Ok((
+        r.force.into_pyarray(py),
+        r.x.into_pyarray(py),
+        r.v.into_pyarray(py),
+        r.z.into_pyarray(py),
+    ))
 }
 
 /// `scale` of `friction_force`: one positive finite factor per sample.
@@ -316,6 +377,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check_model, m)?)?;
     m.add_function(wrap_pyfunction!(stribeck, m)?)?;
     m.add_function(wrap_pyfunction!(friction_force, m)?)?;
+    m.add_function(wrap_pyfunction!(load_coupling, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_batch, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;

@@ -1,8 +1,10 @@
 //! The servo axis: model description and simulation.
 
+pub mod coupling;
 pub mod model;
 pub mod sim;
 
+pub use coupling::{load_coupling, Coupling, CouplingOptions, LoadTrajectory};
 pub use model::{
     Axis, ControlLaw, Controller, CurrentLoop, Effect, Feedforward, FeedforwardKind, Model,
 };

@@ -156,19 +156,19 @@ struct Physics<const EXTRAS: bool> {
 
 /// The two bodies of the `resonance` effect and their coupling.
 #[derive(Debug, Clone, Copy)]
-struct TwoMass {
+pub(crate) struct TwoMass {
     /// Coupling stiffness [N/m].
-    k: f64,
+    pub(crate) k: f64,
     /// Coupling damping [N s/m].
-    c: f64,
+    pub(crate) c: f64,
     /// Motor-side mass `(1 - r)*M` [kg].
-    mm: f64,
+    pub(crate) mm: f64,
     /// Load-side mass `r*M` [kg].
-    ml: f64,
+    pub(crate) ml: f64,
 }
 
 impl TwoMass {
-    fn new(mass: f64, frequency_hz: f64, damping_ratio: f64, r: f64) -> Self {
+    pub(crate) fn new(mass: f64, frequency_hz: f64, damping_ratio: f64, r: f64) -> Self {
         let mm = (1.0 - r) * mass;
         let ml = r * mass;
         let w = 2.0 * PI * frequency_hz;
