@@ -539,26 +539,6 @@ class Resonance(_Secant):
         out[:] = g
         return out
 
-    def columns(self, h: Any, ctx: Context) -> np.ndarray:
-        if any(e["effect"] == "resonance" for e in ctx.model.effects):
-            return super().columns(h, ctx)
-        from scipy import signal
-
-        from . import residual as R
-
-        sig = ctx.sig
-        key = ("load_force", id(ctx.model))
-        if key not in ctx.extra:  # filtered friction and effect forces of the base
-            m = R.total_mass(ctx.model)
-            ctx.extra[key] = (m, R.model_force(ctx.model, sig) - m * sig.a)
-        m, ffr = ctx.extra[key]
-        f, z, r = h
-        b, a = R.coupling(f, z, sig.dt, R.load_damping(ctx.model, r))
-        u = r * m * sig.a + ffr
-        passed = signal.lfilter(b, a, u, zi=signal.lfilter_zi(b, a) * u[0])[0]
-        # r(without) - r(with) = model force with the coupling - without it
-        return ((1.0 - r) * m * sig.a + passed - (m * sig.a + ffr))[:, None]
-
     def effect_at(self, h: Any) -> dict[str, Any]:
         f, z, r = h
         return {"effect": "resonance", "frequency": float(f), "damping_ratio": float(z),

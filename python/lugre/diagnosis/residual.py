@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-from .._native import friction_force
+from .._native import friction_force, load_coupling
 from ..exceptions import DataError, InputError, UnitsWarning
 from ..io import Recording
 from ..model import Model, _as_model
@@ -309,7 +309,7 @@ def prepare(
     return Signals(t=tt, dt=dt, fs=fs, cutoff_hz=fc, x=x, v=v, vf=vf, a=a, fm=fm,
                    fm_f=fm_f, dfm=dfm, spikes=spikes, mask=mask, x_raw=rec.x.copy(),
                    force_raw=force_raw, recording=rec,
-                   info={"drive_cutoff_hz": fd, "quantum": q, "edge": edge})
+                   info={"drive_cutoff_hz": fd, "quantum": q, "edge": edge, "x_drive": xd})
 
 
 # --------------------------------------------------------------------------------------
@@ -478,30 +478,15 @@ def effect_force(model: Model, sig: Signals) -> np.ndarray:
     return out
 
 
-def coupling(frequency: float, damping_ratio: float, dt: float, extra_damping: float = 0.0
-             ) -> tuple[np.ndarray, np.ndarray]:
-    """Discrete ``G(s) = (2*zeta*w*s + w^2)/(s^2 + (2*zeta*w + d)*s + w^2)`` (bilinear,
-    warped at the resonance, at most 0.45 of the sample rate): the force a spring-damper
-    passes to a load, per unit of the force the load needs; ``d`` [1/s] is the damping
-    the load's own viscous friction adds to its motion against the motor
-    (``sigma2/(r*m)``)."""
-    w = 2.0 * math.pi * frequency
-    f0 = min(frequency, 0.45 / dt)
-    w0 = 2.0 * math.pi * f0
-    K = w0 / math.tan(w0 * dt / 2.0)  # s -> K*(z - 1)/(z + 1)
-    a1, a0 = 2.0 * damping_ratio * w, w * w
-    d1 = a1 + extra_damping
-    # (a1*s + a0)/(s^2 + d1*s + a0) with s = K*(1 - q)/(1 + q), q = 1/z
-    b = np.array([a1 * K + a0, 2.0 * a0, a0 - a1 * K])
-    a = np.array([K * K + d1 * K + a0, 2.0 * a0 - 2.0 * K * K, K * K - d1 * K + a0])
-    return b / a[0], a / a[0]
-
-
-def load_damping(model: Model, load_fraction: float) -> float:
-    """Damping [1/s] of the load's motion against the motor from its viscous friction."""
-    f = model.friction
-    s2 = 0.5 * (f["positive"]["sigma2"] + f["negative"]["sigma2"])
-    return s2 / (load_fraction * total_mass(model))
+def coupling_force(model: Model, sig: Signals) -> np.ndarray:
+    """Unfiltered force the compliant coupling of the model's ``resonance`` passes to the
+    load, the load simulated along the filtered motor motion with its friction (and the
+    friction scales) and the effect forces on it (``lugre.load_coupling``)."""
+    # the motion that drives the bristles of the rigid model, and substeps so that the
+    # load's bristles trail the samples by 1/16 of an interval, not by half of one
+    return load_coupling(sig.info["x_drive"], sig.v, sig.dt, model,
+                         scale=friction_scale(model, sig), extra=effect_force(model, sig),
+                         substeps=8).force
 
 
 def total_mass(model: Model) -> float:
@@ -512,23 +497,18 @@ def total_mass(model: Model) -> float:
 def model_force(model: Model, sig: Signals) -> np.ndarray:
     """Filtered force the model needs besides the motor: ``m*a + F_friction + F_effects``.
 
-    With a ``resonance`` the encoder sees the motor, ``(1 - r)*m``, and the load
-    ``r*m`` carries the friction and the effect forces through a spring-damper: the
-    motor gives ``(1 - r)*m*a + G(r*m*a + F_load)``, ``G`` the coupling's transfer
-    (:func:`coupling`), to first order in the deflection (the load's friction taken
-    at the motor's velocity, its viscous part damping the deflection).
+    With a ``resonance`` the encoder sees the motor, ``(1 - r)*m``, and the load ``r*m``
+    carries the friction and the effect forces behind a spring-damper: the motor gives
+    ``(1 - r)*m*a + F_s``, ``F_s`` the force the coupling passes to the load, simulated
+    along the measured motor motion (:func:`coupling_force`).
     """
-    fr = base_friction(model, sig) + effect_force(model, sig)
     m = total_mass(model)
     res = next((e for e in model.effects if e["effect"] == "resonance"), None)
     if res is None:
+        fr = base_friction(model, sig) + effect_force(model, sig)
         return m * sig.a + sig.filt(fr)
     r = float(res["load_fraction"])
-    b, a = coupling(float(res["frequency"]), float(res["damping_ratio"]), sig.dt,
-                    load_damping(model, r))
-    u = r * m * sig.a + sig.filt(fr)
-    zi = signal.lfilter_zi(b, a) * u[0]
-    return (1.0 - r) * m * sig.a + signal.lfilter(b, a, u, zi=zi)[0]
+    return (1.0 - r) * m * sig.a + sig.filt(coupling_force(model, sig))
 
 
 def residual(model: Model, sig: Signals) -> np.ndarray:
