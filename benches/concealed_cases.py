@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 from lugre import save_model
-from lugre.diagnosis.synth import case
+from lugre.diagnosis.synth import axis_model, case
 
 
 def write(out: Path, name: str, effects: list[dict], **kw) -> None:
@@ -66,6 +66,27 @@ def main() -> None:
         write(out, f"half_{name}", [e], seed=500 + j, kind=kinds[j % 3], duration=dur)
     write(out, "combo_cogging_offset", [half["cogging"], half["offset"]], seed=600,
           kind="sines", duration=dur)
+    # the same effects on random axes, sized against each axis' friction and mass
+    for j, name in enumerate(half):
+        ax = axis_model(40 + j)
+        fc = ax.positive["fc"]
+        e = {
+            "cogging": {"effect": "cogging", "amplitude": 0.06 * fc, "pitch": 0.016,
+                        "phase": 0.3},
+            "offset": {"effect": "offset", "force": 0.06 * fc},
+            "spring": {"effect": "spring", "stiffness": 0.4 * fc, "x0": 0.0},
+            "drift": {"effect": "drift", "gain": 0.1, "time_constant": 5.0},
+            "payload": {"effect": "mass", "delta": 0.06 * ax.mass},
+            "delay": {"effect": "delay", "seconds": 0.0008},
+            "current_lag": {"effect": "current_lag", "bandwidth": 90.0},
+            "deadband": {"effect": "deadband", "current": 0.06 * fc / ax.force_constant},
+            "drag": {"effect": "drag", "coefficient": 0.1 * fc / 0.04},
+            "stribeck_shape": {"effect": "stribeck_shape", "exponent": 1.1},
+            "resonance": {"effect": "resonance", "frequency": 26.0, "damping_ratio": 0.05,
+                          "load_fraction": 0.7},
+        }[name]
+        write(out, f"axis_{name}", [e], seed=700 + j, axis_seed=40 + j, kind=kinds[j % 3],
+              duration=dur)
     write(out, "combo_deadband_drag", [half["deadband"], half["drag"]], seed=601,
           kind="p2p", duration=dur)
 
