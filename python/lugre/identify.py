@@ -58,6 +58,8 @@ class DirectionFit:
     """Robust residual scale (1.4826 MAD) [N]."""
     iterations: int
     converged: bool
+    cov: np.ndarray = field(default_factory=lambda: np.full((4, 4), np.nan))
+    """Joint covariance of ``fc, fs, sigma2, vs`` (NaN where it cannot be computed)."""
 
     @classmethod
     def _from_core(cls, d: dict[str, Any]) -> DirectionFit:
@@ -72,6 +74,7 @@ class DirectionFit:
             scale=float(d["scale"]),
             iterations=int(d["iterations"]),
             converged=bool(d["converged"]),
+            cov=np.asarray(d.get("cov", [np.nan] * 16), dtype=float).reshape(4, 4),
         )
 
 
