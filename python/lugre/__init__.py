@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from ._native import friction_force, simulate, simulate_batch, stribeck
 from ._result import SimResult
+from .design import StaticDesign, design_static
 from .diagnosis import Diagnosis, diagnose, evaluate, fit_inverse_dynamics
 from .exceptions import (
     ConvergenceWarning,
@@ -33,6 +34,7 @@ from .identify import (
     fit_dynamic,
     fit_static,
     steady_state_points,
+    stribeck_determinacy,
 )
 from .io import Recording, read_points, read_recording, write_recording
 from .model import Model, load_model, save_model
@@ -55,9 +57,11 @@ __all__ = [
     "PassivityWarning",
     "Recording",
     "SimResult",
+    "StaticDesign",
     "StaticFit",
     "SteadyStatePoints",
     "UnitsWarning",
+    "design_static",
     "diagnose",
     "evaluate",
     "fit_dynamic",
@@ -72,5 +76,6 @@ __all__ = [
     "simulate_batch",
     "steady_state_points",
     "stribeck",
+    "stribeck_determinacy",
     "write_recording",
 ]

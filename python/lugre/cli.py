@@ -63,6 +63,26 @@ def _cmd_fit_static(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_design_static(args: argparse.Namespace) -> int:
+    from .design import design_static
+    from .identify import fit_static
+    from .io import read_points
+
+    _guard_output(args.json, args.points)
+    v, F = read_points(args.points)
+    fit = fit_static(v, F, weighting=args.weighting)
+    print(f"{args.points}: {len(v)} steady-state points; first fit:")
+    print(fit.summary())
+    rng = tuple(args.speed_range) if args.speed_range else None
+    design = design_static(fit, target=args.target, budget=args.budget, speed_range=rng,
+                           min_repeats=args.repeats, noise=args.noise)
+    print(design.summary())
+    if args.json:
+        _write_json(args.json, design.to_dict())
+        print(f"design written to {args.json}")
+    return 0
+
+
 def _cmd_fit_dynamic(args: argparse.Namespace) -> int:
     from .identify import fit_dynamic
     from .model import load_model, save_model
@@ -171,6 +191,10 @@ def _cmd_fit(args: argparse.Namespace) -> int:
               f"vs {p['vs']:.4g} m/s")
     print(f"mass {model.mass:.4g} kg, sigma0 {model.sigma0:.4g} N/m, sigma1 {model.sigma1:.4g} N s/m, "
           f"force constant {model.force_constant:.4g} N/A")
+    from .identify import stribeck_determinacy
+
+    for note in stribeck_determinacy(rec, model):
+        print(f"note: {note}")
     save_model(model, args.json)
     print(f"model written to {args.json}")
     return 0
@@ -213,6 +237,21 @@ def build_parser() -> argparse.ArgumentParser:
                     help="points per settled plateau of a raw record (default 3)")
     fs.add_argument("--plot", metavar="PNG", help="write a figure of the fit")
     fs.set_defaults(func=_cmd_fit_static)
+
+    ds = sub.add_parser("design-static", help="from a first static fit, the speeds and runs "
+                        "per speed that reach a target precision of every Stribeck parameter")
+    ds.add_argument("points", metavar="POINTS", help="CSV of steady-state points (v, F)")
+    ds.add_argument("--json", metavar="DESIGN.json", help="write the design")
+    ds.add_argument("--target", type=float, default=0.003,
+                    help="relative standard error wanted for every parameter (default 0.003)")
+    ds.add_argument("--budget", type=int, default=96, help="most runs per direction (96)")
+    ds.add_argument("--repeats", type=int, default=3,
+                    help="runs at least per chosen speed, so gross errors stay detectable (3)")
+    ds.add_argument("--speed-range", type=float, nargs=2, metavar=("LO", "HI"),
+                    help="speeds the axis can hold [m/s] (default vs/50 to 40 vs)")
+    ds.add_argument("--noise", type=float, help="force noise [N] (default: the fit's scale)")
+    ds.add_argument("--weighting", **w)
+    ds.set_defaults(func=_cmd_design_static)
 
     fd = sub.add_parser("fit-dynamic", help="sigma0 and sigma1 from a closed-loop record "
                         "(with x_ref) under the model's controller, static sets held")
