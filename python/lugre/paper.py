@@ -42,10 +42,10 @@ CHOICES: dict[str, Any] = {
     "presliding": "beyond the paper: open-loop force at standstill, a sine sweep 2-25 Hz "
                   "(log) whose amplitude rises from 0.08 fc to 0.8 fc and falls back over "
                   "2 x 2 s at 10 kHz, 0.05 N white force noise the fit does not know, "
-                  "position quantised to 50 nm; static sets held at Table 1's IGG fit "
-                  "(its covariance carried into the intervals for fc, which is held); "
-                  "sigma0, sigma1 and sigma2, fs, vs of each direction fitted together "
-                  "(Gauss-Newton, scipy least_squares)",
+                  "position quantised to 50 nm; sigma0, sigma1 and fc, fs, sigma2, vs of "
+                  "each direction fitted together (scipy least_squares), the static ones "
+                  "started at Table 1's IGG fit; sandwich intervals with a Newey-West "
+                  "long-run covariance and fixed-b critical values",
     "tracking": "v_d = sin(2 pi t) m/s under a PI speed loop kp = 1200 N s/m, ki = 12000 N/m "
                 "at 10 kHz; maximum error over the second second; compensation = LuGre "
                 "feed-forward of the identified model driven by v_d",
@@ -213,7 +213,7 @@ def run_paper(out_dir: str | os.PathLike[str], *, seed: int = 1, monte_carlo: in
     # its own stream, so the record does not depend on the Monte Carlo's size
     pre = _presliding(truth, igg, np.random.default_rng([seed, 2]))
     say("\nTable 2, beyond the paper: presliding record at standstill (open-loop force "
-        "sweep below break-away), fitted with sigma2, fs and vs of each direction")
+        "sweep below break-away), fitted with the static parameters of each direction")
     say(f"  {'':16s}{'actual':>9s} {'paper':>9s} {'err':>8s} | {'ours':>10s} {'err':>9s}  "
         f"{'95 % CI':>24s}  verdict")
     table2 = {}

@@ -91,13 +91,14 @@ def _sim_x(model: Model, t: np.ndarray, force: np.ndarray, theta: np.ndarray) ->
     return simulate(m, t, current=force / model.force_constant).x
 
 
-def _hac(score: np.ndarray, r: np.ndarray) -> np.ndarray:
+def _hac(score: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, float]:
     """Heteroscedasticity- and autocorrelation-consistent middle of the sandwich
     covariance (Newey and West 1987, Bartlett weights): the residual of a presliding
     record is the axis's response to force noise, coloured by the presliding
     resonance, so neighbouring samples are far from independent. The bandwidth is
     1.5 times the last lag at which the residual's autocorrelation exceeds 0.1 in
-    magnitude (at most a quarter of the record)."""
+    magnitude (at most a quarter of the record). Returns the matrix and ``b``, the
+    bandwidth as a share of the record."""
     n = r.size
     m = 1 << int(np.ceil(np.log2(2 * n)))
     R = np.fft.rfft(r - r.mean(), m)
@@ -114,7 +115,7 @@ def _hac(score: np.ndarray, r: np.ndarray) -> np.ndarray:
     for i in range(p):
         cc = np.fft.irfft(S[:, i:i + 1] * np.conj(S), m, axis=0)   # sum_t s_i(t+l) s_j(t)
         out[i] = w_full @ cc
-    return 0.5 * (out + out.T)
+    return 0.5 * (out + out.T), L / n
 
 
 def fit_presliding(t: np.ndarray, x: np.ndarray, force: np.ndarray, model: Model, *,
@@ -183,7 +184,12 @@ def fit_presliding(t: np.ndarray, x: np.ndarray, force: np.ndarray, model: Model
     r = sol.fun * xs
     J = sol.jac * xs
     JtJ_inv = np.linalg.pinv(J.T @ J)
-    cov = JtJ_inv @ _hac(J * r[:, None], r) @ JtJ_inv
+    H, b = _hac(J * r[:, None], r)
+    cov = JtJ_inv @ H @ JtJ_inv
+    # fixed-b critical value of the Bartlett kernel (Kiefer and Vogelsang 2005): a
+    # bandwidth that is a sizeable share of the record leaves the long-run variance
+    # itself uncertain, which the normal quantile 1.96 ignores
+    q = 1.96 + 2.9694 * b + 0.4160 * b ** 2 - 0.5324 * b ** 3
     static_var = np.zeros(len(NAMES))
     contrib: dict[str, float] = {}
     if static_fit is not None:
@@ -215,7 +221,7 @@ def fit_presliding(t: np.ndarray, x: np.ndarray, force: np.ndarray, model: Model
                 if f"{k}_{d}" not in NAMES:
                     contrib[f"{k} ({d})"] = float(np.max(np.abs(G[:, j]) * np.sqrt(C[j, j])))
     var = np.diag(cov) + static_var
-    half = 1.96 * np.sqrt(var)
+    half = q * np.sqrt(var)
     est = np.exp(th)
     lo, hi = est * np.exp(-half), est * np.exp(half)
     rel = (hi - lo) / (2 * est)
