@@ -37,7 +37,7 @@ use super::robust::{median, robust_scale, t_quantile_975, Weighting};
 use crate::error::{check_finite, check_len, Error, Result};
 use crate::friction::StaticSet;
 use reweight::{irls_vp, refit_kept, Cfg, Outcome, Stage};
-use starts::{clamp_start, lts_h, refine_lts, start_values_huber, start_values_lts};
+use starts::{clamp_start, lts_sizes, refine_lts, start_values_huber, start_values_lts};
 use varpro::Sep;
 
 /// Fewest nonzero-speed points per direction that [`fit_static`] accepts (4 parameters
@@ -198,17 +198,15 @@ fn fit_direction(
     let huber_start = clamp_start(start_values_huber(&mut sep), a, fscale);
     let out = if reject_at.is_some() {
         // Redescending weights (IGG, Tukey) settle on the set of rejected points near
-        // their start. Three starts, as in MM-estimation (Yohai 1987): (a) a Huber pass
-        // (monotone, unique fixed point) from the Huber grid; (b), (c) a Tukey pass from
-        // least trimmed squares on about half and on three quarters of the points
-        // (grid, then `vs` freed), which also resist gross errors of high leverage
-        // (the fastest and slowest points) that a Huber fit follows; the half subset
-        // breaks down last, the larger one keeps the Stribeck hump when few points
-        // describe it. The fit with the smallest bounded (Tukey) loss at a common scale
+        // their start. Four starts, as in MM-estimation (Yohai 1987): (a) a Huber pass
+        // (monotone, unique fixed point) from the Huber grid; (b)-(d) a Tukey pass from
+        // least trimmed squares on half, three quarters and two fifths of the points
+        // (grid, then `vs` freed, [`lts_sizes`]), which also resist gross errors of high
+        // leverage (the fastest and slowest points) that a Huber fit follows. The fit with the smallest bounded (Tukey) loss at a common scale
         // wins, as in the choice among local minima of an MM-estimate.
         let mut paths = vec![path(&mut sep, huber_start, Some(Weighting::huber()))];
         let n = a.len();
-        for h in [lts_h(n), (3 * n).div_ceil(4).min(n)] {
+        for h in lts_sizes(n) {
             let mut refined: Vec<(f64, [f64; 4])> = start_values_lts(&mut sep, h)
                 .into_iter()
                 .map(|p0| {

@@ -187,7 +187,7 @@ impl Lts {
 /// the grid instead of being repeated at every node.
 pub(super) fn start_values_lts(sep: &mut Sep, h: usize) -> Vec<[f64; 4]> {
     let n = sep.a.len();
-    const SEEDS_PER_NODE: usize = 3;
+    const SEEDS_PER_NODE: usize = 12;
     let nodes = grid_nodes(sep.a, GRID_NODES);
     let seeds = elemental_seeds(sep.a, SEEDS_PER_NODE * nodes.len());
     let mut lts = Lts {
@@ -313,10 +313,18 @@ pub(super) fn refine_lts(
     best
 }
 
-/// Subset size of the least-trimmed-squares start: `(n + p + 1)/2` with `p = 3` linear
-/// parameters, the largest breakdown point (about one half) that the fit allows.
-pub(super) fn lts_h(n: usize) -> usize {
-    ((n + 4) / 2).min(n)
+/// Subset sizes of the least-trimmed-squares starts: `(n + p + 1)/2` with `p = 3`
+/// linear parameters (breakdown point about one half), three quarters of the points
+/// (keeps the Stribeck hump when few points describe it) and two fifths (gross errors
+/// scattered at random do not lie on one curve, so a smaller subset of clean points
+/// still wins when a direction holds more than half gross errors). At least 5 points.
+pub(super) fn lts_sizes(n: usize) -> [usize; 3] {
+    let clamp = |h: usize| h.max(5).min(n);
+    [
+        clamp((n + 4) / 2),
+        clamp((3 * n).div_ceil(4)),
+        clamp((2 * n).div_ceil(5)),
+    ]
 }
 
 /// Keep start values inside the model's domain (all positive, `fs > fc`).
