@@ -357,9 +357,13 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
         Column mapping when ``recording`` is a path.
     static_fit : StaticFit, optional
         The static step whose sets the model holds. Its uncertainty is carried into the
-        intervals of sigma0 and sigma1 (delta method: one refit per static parameter
-        moved by its standard error), since a static error shifts the dynamic estimates
-        (sigma1 above all: the presliding damping is sigma1 + sigma2).
+        intervals of sigma0 and sigma1: per direction, refits with the static set moved
+        by one standard deviation either way along each principal axis of its joint
+        covariance (sigma points), which give the variance and the mean shift of the
+        estimates that the static errors cause (second order). On the paper's axis the
+        stick-slip estimate of sigma1 depends far from linearly on the break-away
+        parameters (fs, vs), so even this interval can miss; a presliding record
+        (:mod:`lugre.presliding`) determines sigma1 directly.
 
     Warns
     -----
