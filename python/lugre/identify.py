@@ -435,7 +435,11 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
         if shifts:
             var = var + static_var
             half = 1.96 * np.sqrt(var)
-            lo, hi = est * np.exp(-static_bias - half), est * np.exp(-static_bias + half)
+            # the interval covers the estimate and the estimate less the mean shift:
+            # when the refits jump between local minima the curvature term is not
+            # to be trusted as a correction, only as a width
+            lo = est * np.exp(np.minimum(0.0, -static_bias) - half)
+            hi = est * np.exp(np.maximum(0.0, -static_bias) + half)
             rel = (hi - lo) / (2 * est)
             for j, k in enumerate(names):
                 share = static_var[j] / var[j]
@@ -456,6 +460,16 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
                        "standstill, lugre.presliding) or tighten the static step around vs "
                        "(lugre design-static)"
                        if was and not identifiable[j] else ""))
+    # an interval that cannot be computed (an estimate at the bound, a refit that
+    # failed) says nothing: report it as unbounded and the parameter as undetermined
+    for j, k in enumerate(names):
+        if not (np.isfinite(lo[j]) and np.isfinite(hi[j])):
+            lo, hi = np.array(lo, float), np.array(hi, float)
+            lo[j], hi[j] = 0.0, np.inf
+            if identifiable[j]:
+                notes.append(f"{k}: its interval cannot be computed (estimate {est[j]:.4g} "
+                             "at or near a bound): NOT determined by this record")
+            identifiable[j] = False
     fit = DynamicFit(
         sigma0=float(est[0]), sigma1=float(est[1]),
         std_err=dict(zip(names, map(float, r["std_err"]))),
