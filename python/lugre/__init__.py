@@ -48,6 +48,9 @@ _LAZY = {
     "StaticFit": ".identify",
     "SteadyStatePoints": ".identify",
     "fit_static": ".identify",
+    "stribeck_determinacy": ".identify",
+    "StaticDesign": ".design",
+    "design_static": ".design",
 }
 
 
@@ -147,9 +150,11 @@ __all__ = [
     "PassivityWarning",
     "Recording",
     "SimResult",
+    "StaticDesign",
     "StaticFit",
     "SteadyStatePoints",
     "UnitsWarning",
+    "design_static",
     "diagnose",
     "evaluate",
     "fit_dynamic",
@@ -165,5 +170,6 @@ __all__ = [
     "simulate_batch",
     "steady_state_points",
     "stribeck",
+    "stribeck_determinacy",
     "write_recording",
 ]

@@ -103,6 +103,26 @@ def _columns(spec: str | None) -> str | None:
     return spec or None
 
 
+def _cmd_design_static(args: argparse.Namespace) -> int:
+    from .design import design_static
+    from .identify import fit_static
+    from .io import read_points
+
+    _check_outputs({"POINTS": args.points}, {"--json": args.json})
+    v, F = read_points(args.points)
+    fit = fit_static(v, F, weighting=args.weighting)
+    print(f"{args.points}: {len(v)} steady-state points; first fit:")
+    print(fit.summary())
+    rng = tuple(args.speed_range) if args.speed_range else None
+    design = design_static(fit, target=args.target, budget=args.budget, speed_range=rng,
+                           min_repeats=args.repeats, noise=args.noise)
+    print(design.summary())
+    if args.json:
+        _write_json(args.json, design.to_dict())
+        print(f"design written to {args.json}")
+    return 0
+
+
 def _write_json(path: str, obj: object) -> None:
     import json
 
@@ -368,6 +388,10 @@ def _cmd_fit(args: argparse.Namespace) -> int:
               f"vs {p['vs']:.4g} m/s")
     print(f"mass {model.mass:.4g} kg, sigma0 {model.sigma0:.4g} N/m, sigma1 {model.sigma1:.4g} "
           f"N s/m, force constant {model.force_constant:.4g} N/A")
+    from .identify import stribeck_determinacy
+
+    for note in stribeck_determinacy(rec, model):
+        print(f"note: {note}")
     page = None
     if args.html:
         from .html import fit_page
@@ -434,6 +458,7 @@ _EXAMPLES = {
     "fit": "lugre fit recording.csv --force-constant 25 --json model.json --html fit.html\n"
            "  lugre fit DATA_EMPS.mat --columns 'x=qm,x_ref=qg,F=gtau*vir' --json emps.json",
     "paper": "lugre paper --out paper/ --html paper.html",
+    "design-static": "lugre design-static points.csv --target 0.003 --budget 96 --json design.json",
 }
 
 
@@ -496,6 +521,21 @@ def build_parser() -> argparse.ArgumentParser:
     fs.add_argument("--plot", metavar="PNG", help="write a figure of the fit")
     fs.add_argument("--html", metavar="PAGE.html", help="write a self-contained HTML page")
     fs.set_defaults(func=_cmd_fit_static)
+
+    ds = _add(sub, "design-static", "from a first static fit, the speeds and runs per speed "
+              "that reach a target precision of every Stribeck parameter", common)
+    ds.add_argument("points", metavar="POINTS", help="CSV of steady-state points (v, F)")
+    ds.add_argument("--json", metavar="DESIGN.json", help="write the design")
+    ds.add_argument("--target", type=_POSITIVE, default=0.003,
+                    help="relative standard error wanted for every parameter")
+    ds.add_argument("--budget", type=int, default=96, help="most runs per direction")
+    ds.add_argument("--repeats", type=int, default=3,
+                    help="runs at least per chosen speed, so gross errors stay detectable")
+    ds.add_argument("--speed-range", type=float, nargs=2, metavar=("LO", "HI"),
+                    help="speeds the axis can hold [m/s] (default vs/50 to 40 vs)")
+    ds.add_argument("--noise", type=_POSITIVE, help="force noise [N] (default: the fit's scale)")
+    ds.add_argument("--weighting", **w)
+    ds.set_defaults(func=_cmd_design_static)
 
     fd = _add(sub, "fit-dynamic", "sigma0 and sigma1 from a closed-loop record (with x_ref) "
               "under the model's controller, static sets held", common)

@@ -33,6 +33,7 @@ __all__ = [
     "fit_dynamic",
     "fit_static",
     "steady_state_points",
+    "stribeck_determinacy",
 ]
 
 STATIC_NAMES = ("fc", "fs", "sigma2", "vs")
@@ -58,6 +59,8 @@ class DirectionFit:
     """Robust residual scale (1.4826 MAD) [N]."""
     iterations: int
     converged: bool
+    cov: np.ndarray = field(default_factory=lambda: np.full((4, 4), np.nan))
+    """Joint covariance of ``fc, fs, sigma2, vs`` (NaN where it cannot be computed)."""
 
     @classmethod
     def _from_core(cls, d: dict[str, Any]) -> DirectionFit:
@@ -72,6 +75,7 @@ class DirectionFit:
             scale=float(d["scale"]),
             iterations=int(d["iterations"]),
             converged=bool(d["converged"]),
+            cov=np.asarray(d.get("cov", [np.nan] * 16), dtype=float).reshape(4, 4),
         )
 
 
@@ -353,9 +357,13 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
         Column mapping when ``recording`` is a path.
     static_fit : StaticFit, optional
         The static step whose sets the model holds. Its uncertainty is carried into the
-        intervals of sigma0 and sigma1 (delta method: one refit per static parameter
-        moved by its standard error), since a static error shifts the dynamic estimates
-        (sigma1 above all: the presliding damping is sigma1 + sigma2).
+        intervals of sigma0 and sigma1: per direction, refits with the static set moved
+        by one standard deviation either way along each principal axis of its joint
+        covariance (sigma points), which give the variance and the mean shift of the
+        estimates that the static errors cause (second order). On the paper's axis the
+        stick-slip estimate of sigma1 depends far from linearly on the break-away
+        parameters (fs, vs), so even this interval can miss; a presliding record
+        (:mod:`lugre.presliding`) determines sigma1 directly.
 
     Warns
     -----
@@ -384,24 +392,54 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
         # delta method on ln(sigma): noise part from the core's interval, static part
         # from refits with each static parameter moved by one standard error
         var = ((np.log(hi) - np.log(lo)) / (2 * 1.96)) ** 2
-        shifts = []
+        # the static step's joint covariance carried by sigma points: for each
+        # direction, refits with the static set moved by +-1 standard deviation along
+        # each principal axis of its covariance (fs and vs errors are strongly
+        # correlated). Half the difference of a pair is the linear term, half the sum
+        # (less twice the centre) the curvature: the variance is the sum of the squared
+        # linear terms, and the curvature terms add up to the mean shift of ln sigma
+        # that the static errors cause (second-order delta method), which moves the
+        # interval (1 % in fs moves sigma1 by about 2x, far from linear).
+        static_var = np.zeros(2)
+        static_bias = np.zeros(2)
+        contrib: dict[str, np.ndarray] = {}
         for d in ("positive", "negative"):
             df = getattr(static_fit, d)
-            for k in STATIC_NAMES:
-                se = df.std_err[k]
-                if not np.isfinite(se) or se <= 0:
+            C = np.asarray(df.cov, float)
+            if not np.all(np.isfinite(C)):
+                C = np.diag([df.std_err[k] ** 2 if np.isfinite(df.std_err[k]) else 0.0
+                             for k in STATIC_NAMES])
+            lam, U = np.linalg.eigh(0.5 * (C + C.T))
+            base = np.array([getattr(m, d)[k] for k in STATIC_NAMES])
+            lin = np.zeros((2, 4))
+            for i in range(4):
+                if not lam[i] > 0:
                     continue
-                sets = {dd: dict(getattr(m, dd)) for dd in ("positive", "negative")}
-                sets[d][k] = sets[d][k] + se
-                if sets[d]["fs"] < sets[d]["fc"]:
-                    continue
-                rr = run(m.with_friction(**sets), float(est[0]), float(est[1]), False)
-                shifts.append(np.log([rr["sigma0"], rr["sigma1"]]) - np.log(est))
+                step = np.sqrt(lam[i]) * U[:, i]
+                ys = []
+                for sgn in (1.0, -1.0):
+                    p_new = base + sgn * step
+                    if p_new[1] < p_new[0] or np.any(p_new <= 0):
+                        p_new = base + sgn * step * 0.5
+                    sets = {dd: dict(getattr(m, dd)) for dd in ("positive", "negative")}
+                    sets[d] = dict(zip(STATIC_NAMES, map(float, p_new)))
+                    rr = run(m.with_friction(**sets), float(est[0]), float(est[1]), False)
+                    ys.append(np.log([rr["sigma0"], rr["sigma1"]]) - np.log(est))
+                lin[:, i] = 0.5 * (ys[0] - ys[1])
+                static_var += lin[:, i] ** 2
+                static_bias += 0.5 * (ys[0] + ys[1])
+            # share of each static parameter: its loading on the principal axes
+            for j, k in enumerate(STATIC_NAMES):
+                contrib[f"{k} ({d})"] = lin @ (U[j, :] ** 2)
+        shifts = [static_var] if np.any(static_var > 0) else []
         if shifts:
-            static_var = np.sum(np.square(shifts), axis=0)
             var = var + static_var
             half = 1.96 * np.sqrt(var)
-            lo, hi = est * np.exp(-half), est * np.exp(half)
+            # the interval covers the estimate and the estimate less the mean shift:
+            # when the refits jump between local minima the curvature term is not
+            # to be trusted as a correction, only as a width
+            lo = est * np.exp(np.minimum(0.0, -static_bias) - half)
+            hi = est * np.exp(np.maximum(0.0, -static_bias) + half)
             rel = (hi - lo) / (2 * est)
             for j, k in enumerate(names):
                 share = static_var[j] / var[j]
@@ -409,13 +447,29 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
                 # the combined verdict below supersedes the record-only one
                 notes = [n for n in notes if not n.startswith(f"{k} = ")]
                 identifiable[j] = bool(identifiable[j] and rel[j] <= 0.25)
+                big = sorted(contrib, key=lambda c: -abs(contrib[c][j]))[:2]
+                causes = ", ".join(f"{c} ({100 * abs(contrib[c][j]):.0f} % per standard "
+                                   "deviation)" for c in big)
                 notes.append(
-                    f"{k}: with the static step's uncertainty carried over, the 95 % interval "
-                    f"is [{lo[j]:.5g}, {hi[j]:.5g}] (+-{100 * rel[j]:.0f} %), "
-                    f"{100 * share:.0f} % of its variance from the static parameters"
-                    + ("; NOT determined: measure it directly (presliding or break-away "
-                       "tests with small displacements) or tighten the static step"
+                    f"{k}: with the static step's joint covariance carried over, the 95 % "
+                    f"interval is [{lo[j]:.5g}, {hi[j]:.5g}] (+-{100 * rel[j]:.0f} %), "
+                    f"{100 * share:.0f} % of its variance from the static parameters "
+                    f"(largest: {causes}; their errors shift the estimate by "
+                    f"{100 * np.expm1(static_bias[j]):+.0f} % on average)"
+                    + ("; NOT determined: measure it directly (a presliding record at "
+                       "standstill, lugre.presliding) or tighten the static step around vs "
+                       "(lugre design-static)"
                        if was and not identifiable[j] else ""))
+    # an interval that cannot be computed (an estimate at the bound, a refit that
+    # failed) says nothing: report it as unbounded and the parameter as undetermined
+    for j, k in enumerate(names):
+        if not (np.isfinite(lo[j]) and np.isfinite(hi[j])):
+            lo, hi = np.array(lo, float), np.array(hi, float)
+            lo[j], hi[j] = 0.0, np.inf
+            if identifiable[j]:
+                notes.append(f"{k}: its interval cannot be computed (estimate {est[j]:.4g} "
+                             "at or near a bound): NOT determined by this record")
+            identifiable[j] = False
     fit = DynamicFit(
         sigma0=float(est[0]), sigma1=float(est[1]),
         std_err=dict(zip(names, map(float, r["std_err"]))),
@@ -437,3 +491,59 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
         warnings.warn("dynamic fit: IRLS reached its iteration limit", ConvergenceWarning,
                       stacklevel=2)
     return fit
+
+
+def stribeck_determinacy(recording: Recording, model: ModelLike) -> list[str]:
+    """What a record cannot tell about the Stribeck parameters of a fitted model.
+
+    The hump ``fs - fc`` and its width ``vs`` act only below a few ``vs``: a record
+    whose motion in a direction stays faster (or crosses the slow range in a few
+    samples, as at a reversal) cannot determine them, whatever a fit returns. Per
+    direction: when the fit has no hump (``fs`` within 1 % of ``fc``), ``fs`` and ``vs``
+    are named undetermined (any ``vs`` fits equally); otherwise they are when fewer than
+    200 samples (or 2 % of the direction's moving samples) move slower than ``2 vs``.
+
+    Parameters
+    ----------
+    recording : Recording
+        The record the model was fitted to (``v``, or ``x`` differentiated).
+    model : Model, dict or path
+        The fitted model.
+
+    Returns
+    -------
+    list of str
+        One statement per undetermined direction, with the experiment that would
+        determine it; empty when the record covers the slow range.
+    """
+    m = _as_model(model)
+    v = recording.v if recording.v is not None else np.gradient(recording.x, recording.t)
+    v = np.asarray(v, float)
+    top = float(np.max(np.abs(v))) if v.size else 0.0
+    out = []
+    for d, sign, tag in (("positive", 1.0, "v > 0"), ("negative", -1.0, "v < 0")):
+        p = getattr(m, d)
+        moving = sign * v > 1e-3 * top
+        n_mov = int(moving.sum())
+        if n_mov == 0:
+            out.append(f"{tag}: the record never moves this way, so fc, fs, sigma2 and vs of "
+                       "this direction are not determined; record motion in this direction")
+            continue
+        a = np.abs(v[moving])
+        slow = 0.05 * top
+        share_slow = float(np.mean(a < slow))
+        what = (f"constant-velocity runs in this direction from about {slow / 50:.2g} to "
+                f"{slow:.2g} m/s (lugre fit-static; lugre design-static proposes the speeds)")
+        if p["fs"] <= 1.01 * p["fc"]:
+            out.append(f"{tag}: the fit found no Stribeck hump (fs = {p['fs']:.4g} N, fc = "
+                       f"{p['fc']:.4g} N), so fs and vs (= {p['vs']:.3g} m/s, any value fits) "
+                       f"are NOT determined by this record: {100 * share_slow:.1f} % of its "
+                       f"moving samples are slower than {slow:.2g} m/s (5 % of the top "
+                       f"speed). Would determine them: {what}")
+            continue
+        n_hump = int(np.sum(a < 2 * p["vs"]))
+        if n_hump < 200 or n_hump < 0.02 * n_mov:
+            out.append(f"{tag}: fs and vs rest on {n_hump} samples slower than 2 vs = "
+                       f"{2 * p['vs']:.3g} m/s ({100 * n_hump / n_mov:.1f} % of the moving "
+                       f"ones): NOT determined by this record. Would determine them: {what}")
+    return out

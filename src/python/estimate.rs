@@ -19,6 +19,7 @@ fn direction<'py>(py: Python<'py>, d: DirectionFit) -> PyResult<Bound<'py, PyDic
     o.set_item("sigma2", d.set.sigma2)?;
     o.set_item("vs", d.set.vs)?;
     o.set_item("std_err", d.std_err)?;
+    o.set_item("cov", d.cov)?;
     o.set_item("ci_low", d.ci_low)?;
     o.set_item("ci_high", d.ci_high)?;
     o.set_item("indices", d.indices)?;

@@ -1,0 +1,464 @@
+//! Step 1 of the paper's identification: the Stribeck curve of each direction from
+//! steady-state (constant-velocity) points.
+//!
+//! For `v > 0` the model is `F = fc + (fs - fc)*exp(-(v/vs)^2) + sigma2*v` (eq. 7);
+//! for `v < 0` the same curve mirrored, `F = -(fc + ...) + sigma2*v`, with its own
+//! positive parameters (eq. 9). Each direction is fitted separately by robust IRLS
+//! (eqs. 19-24). For a fixed `vs` the curve is linear in `(fc, fs - fc, sigma2)`:
+//! each weighted problem is solved by variable projection (separable least squares,
+//! Golub and Pereyra 1973), the linear parameters in closed form from the 3x3 normal
+//! equations (column-scaled Cholesky; `fc > 0`, `fs >= fc`, `sigma2 >= 0` by an
+//! exhaustive active set when the unconstrained solution violates them), so the
+//! nonlinear search is over `ln vs` alone: a bracket walked downhill, then Nelder-Mead
+//! from the vertex of its parabola.
+//!
+//! Start values need no user input: for a fixed `vs` the curve is linear in
+//! `(fc, fs, sigma2)`, so a grid over `ln vs` with a robust linear fit at each node
+//! gives a start that gross errors do not pull away. With a rejecting weight function (IGG, Tukey) two such
+//! starts are followed to the end, a Huber grid and a least-trimmed-squares grid (the
+//! latter also resists gross errors at the fastest or slowest speeds, which have high
+//! leverage), and the fit with the smaller bounded loss is returned; the
+//! kept points are then refitted by plain least squares, with the rejections
+//! re-checked (beyond 4.685 scale units at least, the bisquare's rejection point),
+//! which recovers the efficiency the down-weighting band costs.
+//!
+//! One idea per file: [`varpro`] the separable problem for fixed weights,
+//! [`reweight`] IRLS and the refit of the kept points, [`starts`] the robust starts
+//! (Huber grid, least trimmed squares), [`intervals`] the covariance; this file the
+//! options, the results and the path from start to answer.
+
+mod intervals;
+mod reweight;
+mod starts;
+mod varpro;
+
+use super::nelder_mead::NmOptions;
+use super::robust::{median, robust_scale, t_quantile_975, Weighting};
+use crate::error::{check_finite, check_len, Error, Result};
+use crate::friction::StaticSet;
+use reweight::{irls_vp, refit_kept, Cfg, Outcome, Stage};
+use starts::{clamp_start, lts_sizes, refine_lts, start_values_huber, start_values_lts};
+use varpro::Sep;
+
+/// Fewest nonzero-speed points per direction that [`fit_static`] accepts (4 parameters
+/// plus one degree of freedom for the residual scale).
+pub const MIN_POINTS_PER_DIRECTION: usize = 5;
+
+/// Names of the static parameters in the order of the per-parameter vectors.
+pub const STATIC_PARAM_NAMES: [&str; 4] = ["fc", "fs", "sigma2", "vs"];
+
+/// Options of [`fit_static`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StaticFitOptions {
+    /// Weight function (IGG by default).
+    pub weighting: Weighting,
+    /// Maximum IRLS (outer) iterations.
+    pub max_iter: usize,
+    /// Stop when the log-parameters move by less than this between iterations.
+    pub tol: f64,
+    /// Lower bound of the residual scale [N] used for the weights. The scale is never
+    /// below `1e-6*median|F|`, so that rounding in noise-free data is not taken for
+    /// gross errors; set this to the force resolution to raise the bound.
+    pub scale_floor: f64,
+    /// Objective evaluations per Nelder-Mead run.
+    pub max_evals: usize,
+    /// With a rejecting weight function (IGG, Tukey): after IRLS, refit by plain least
+    /// squares on the points it kept, then re-check the rejections at the robust scale
+    /// and repeat until the kept set settles (true by default). The down-weighting band
+    /// of IGG costs efficiency on clean Gaussian points; this recovers it.
+    pub refit_kept: bool,
+}
+
+impl Default for StaticFitOptions {
+    fn default() -> Self {
+        Self {
+            weighting: Weighting::igg(),
+            max_iter: 20,
+            tol: 1e-7,
+            scale_floor: 0.0,
+            max_evals: 4000,
+            refit_kept: true,
+        }
+    }
+}
+
+/// The fit of one direction.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DirectionFit {
+    /// Estimated Stribeck parameters (all positive, also for `v < 0`).
+    pub set: StaticSet<f64>,
+    /// Standard errors of `fc, fs, sigma2, vs` (NaN when they cannot be computed).
+    pub std_err: Vec<f64>,
+    /// Joint covariance of `fc, fs, sigma2, vs`, row-major 4x4 (NaN when the standard
+    /// errors are): the static errors are correlated (fs with vs above all), which an
+    /// interval carried into the dynamic step must keep.
+    pub cov: Vec<f64>,
+    /// Lower ends of the 95 % intervals of `fc, fs, sigma2, vs`.
+    pub ci_low: Vec<f64>,
+    /// Upper ends of the 95 % intervals.
+    pub ci_high: Vec<f64>,
+    /// Indices (into the input) of this direction's points.
+    pub indices: Vec<usize>,
+    /// Final IRLS weight of each of these points (0 = rejected).
+    pub weights: Vec<f64>,
+    /// Residual `F - F_model` of each of these points [N] (input sign convention).
+    pub residuals: Vec<f64>,
+    /// Robust scale `1.4826*MAD` of the residuals at the optimum [N].
+    pub scale: f64,
+    /// Weighted residual standard deviation used for the covariance [N].
+    pub sigma: f64,
+    /// IRLS iterations.
+    pub iterations: usize,
+    /// True when the weights or the parameters settled before `max_iter`.
+    pub converged: bool,
+    /// Objective evaluations.
+    pub evaluations: usize,
+}
+
+/// Result of [`fit_static`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct StaticFit {
+    /// Fit of the `v > 0` points.
+    pub positive: DirectionFit,
+    /// Fit of the `v < 0` points.
+    pub negative: DirectionFit,
+    /// Final weight of every input point (0 for rejected and for zero-speed points).
+    pub weights: Vec<f64>,
+    /// Indices of the rejected points (weight 0, zero speeds not included).
+    pub rejected: Vec<usize>,
+    /// Number of zero-speed points ignored.
+    pub n_zero_speed: usize,
+    /// Name of the weight function.
+    pub weighting: String,
+    /// Warnings (iteration limit, ill-determined parameters, ...).
+    pub notes: Vec<String>,
+}
+
+/// Fit one direction to magnitudes `a = |v|` and mirrored forces `y = sign(v)*F`.
+fn fit_direction(
+    a: &[f64],
+    y: &[f64],
+    sign: f64,
+    indices: Vec<usize>,
+    opts: &StaticFitOptions,
+    notes: &mut Vec<String>,
+    label: &str,
+) -> Result<DirectionFit> {
+    let fscale = median(&y.iter().map(|v| v.abs()).collect::<Vec<_>>()).max(1e-12);
+    let mut sep = Sep::new(a, y, fscale);
+    let scale_floor = opts.scale_floor.max(1e-6 * fscale);
+    let cfg = Cfg {
+        max_outer: opts.max_iter,
+        tol: opts.tol,
+        scale_floor,
+        nm: NmOptions {
+            max_evals: opts.max_evals,
+            xtol: 1e-10,
+            ftol: 1e-12,
+            restarts: 0,
+        },
+        nm_loose: NmOptions {
+            max_evals: opts.max_evals,
+            xtol: 1e-10,
+            ftol: 1e-7,
+            restarts: 0,
+        },
+        nm_pre: NmOptions {
+            max_evals: opts.max_evals,
+            xtol: 1e-10,
+            ftol: 1e-5,
+            restarts: 0,
+        },
+        obj_floor: 1e-6 * scale_floor * scale_floor,
+    };
+    let reject_at = match opts.weighting {
+        Weighting::Igg { k1, .. } => Some(k1),
+        Weighting::Tukey { c } => Some(c),
+        _ => None,
+    };
+    // One path: from a start, an optional IRLS pass with another weight function,
+    // IRLS, then (rejecting weight functions) the least-squares refit on the kept points.
+    let path = |sep: &mut Sep, p0: [f64; 4], pre: Option<Weighting>| -> Outcome {
+        let mut p0 = p0;
+        let mut evals = 0;
+        if let Some(w) = pre {
+            let o = irls_vp(sep, p0, w, &cfg, Stage::Pre);
+            p0 = o.p;
+            evals = o.evals;
+        }
+        let refit = opts.refit_kept && reject_at.is_some();
+        let stage = if refit { Stage::Refit } else { Stage::Polish };
+        let mut out = irls_vp(sep, p0, opts.weighting, &cfg, stage);
+        out.evals += evals;
+        if let (true, Some(k1)) = (refit, reject_at) {
+            refit_kept(sep, &mut out, k1.max(reweight::REFIT_REJECT_MIN), &cfg);
+        }
+        out
+    };
+    let huber_start = clamp_start(start_values_huber(&mut sep), a, fscale);
+    let out = if reject_at.is_some() {
+        // Redescending weights (IGG, Tukey) settle on the set of rejected points near
+        // their start. Four starts, as in MM-estimation (Yohai 1987): (a) a Huber pass
+        // (monotone, unique fixed point) from the Huber grid; (b)-(d) a Tukey pass from
+        // least trimmed squares on half, three quarters and two fifths of the points
+        // (grid, then `vs` freed, [`lts_sizes`]), which also resist gross errors of high
+        // leverage (the fastest and slowest points) that a Huber fit follows. The fit with the smallest bounded (Tukey) loss at a common scale
+        // wins, as in the choice among local minima of an MM-estimate.
+        let mut paths = vec![path(&mut sep, huber_start, Some(Weighting::huber()))];
+        let n = a.len();
+        for h in lts_sizes(n) {
+            let mut refined: Vec<(f64, [f64; 4])> = start_values_lts(&mut sep, h)
+                .into_iter()
+                .map(|p0| {
+                    refine_lts(
+                        &mut sep,
+                        clamp_start(Some(p0), a, fscale),
+                        h,
+                        &cfg.nm_pre,
+                        cfg.obj_floor,
+                    )
+                })
+                .filter(|r| r.0.is_finite())
+                .collect();
+            refined.sort_by(|x, y| x.0.total_cmp(&y.0));
+            for (_, p) in refined.into_iter().take(1) {
+                paths.push(path(
+                    &mut sep,
+                    clamp_start(Some(p), a, fscale),
+                    Some(Weighting::tukey()),
+                ));
+            }
+        }
+        // Tukey's rho at a common scale (the smallest robust scale of all): a
+        // rejected point costs the same in each, a kept one its misfit
+        let s = paths
+            .iter()
+            .map(|o| robust_scale(&o.residuals))
+            .fold(f64::INFINITY, f64::min)
+            .max(scale_floor);
+        let c = 4.685;
+        let rho = |o: &Outcome| -> f64 {
+            o.residuals
+                .iter()
+                .map(|e| {
+                    let u = (e / (c * s)).abs().min(1.0);
+                    1.0 - (1.0 - u * u).powi(3)
+                })
+                .sum()
+        };
+        let evals = paths.iter().map(|o| o.evals).sum();
+        let mut best = paths
+            .into_iter()
+            .map(|o| (rho(&o), o))
+            .min_by(|x, y| x.0.total_cmp(&y.0))
+            .map(|x| x.1)
+            .expect("at least the Huber path");
+        best.evals = evals;
+        best
+    } else {
+        path(&mut sep, huber_start, None)
+    };
+    if !out.p.iter().all(|v| v.is_finite()) {
+        return Err(Error::Data(format!(
+            "{label} direction: the Stribeck curve could not be evaluated at the start values; check the data for extreme values"
+        )));
+    }
+    let p = out.p;
+    let iv = intervals::covariance(a, &out.weights, &out.residuals, &p);
+    let (std_err, cov, sigma, n_used, dof) = (iv.std_err, iv.cov, iv.sigma, iv.n_used, iv.dof);
+    if std_err.iter().any(|s| s.is_nan()) {
+        notes.push(format!(
+            "{label} direction: standard errors unavailable ({n_used} points kept for 4 parameters, or a singular Jacobian); add speeds around the Stribeck velocity"
+        ));
+    }
+    let tq = t_quantile_975(dof);
+    let ci_low: Vec<f64> = p.iter().zip(&std_err).map(|(v, s)| v - tq * s).collect();
+    let ci_high: Vec<f64> = p.iter().zip(&std_err).map(|(v, s)| v + tq * s).collect();
+    for (k, name) in STATIC_PARAM_NAMES.iter().enumerate() {
+        let rel = std_err[k] / p[k];
+        if rel > 0.25 {
+            notes.push(format!(
+                "{label} direction: {name} is poorly determined (standard error {:.0} % of the estimate); add constant-velocity points where it acts (around vs for fs and vs, at high speed for sigma2)",
+                rel * 100.0
+            ));
+        }
+    }
+    if !out.converged {
+        notes.push(format!(
+            "{label} direction: IRLS stopped at the iteration limit ({}) before the weights settled",
+            out.iterations
+        ));
+    }
+    Ok(DirectionFit {
+        set: StaticSet {
+            fc: p[0],
+            fs: p[1],
+            sigma2: p[2],
+            vs: p[3],
+        },
+        std_err,
+        cov,
+        ci_low,
+        ci_high,
+        indices,
+        weights: out.weights,
+        residuals: out.residuals.iter().map(|e| sign * e).collect(),
+        scale: out.scale,
+        sigma,
+        iterations: out.iterations,
+        converged: out.converged,
+        evaluations: out.evals,
+    })
+}
+
+/// Fit the Stribeck curve of each direction to steady-state points `(v, F)`.
+///
+/// `F` is the force needed to move at constant speed `v` (the motor force, `K_F*i`);
+/// it is negative for `v < 0`. Zero speeds are ignored (and counted). Each direction
+/// needs at least [`MIN_POINTS_PER_DIRECTION`] points.
+///
+/// ```
+/// use lugre::estimate::{fit_static, StaticFitOptions};
+/// use lugre::friction::StaticSet;
+/// let truth = StaticSet::new(28.7, 60.2, 332.5, 0.01).unwrap();
+/// let v: Vec<f64> = (0..12)
+///     .map(|k| 2e-4 * (2000.0f64).powf(k as f64 / 11.0))
+///     .flat_map(|s| [s, -s])
+///     .collect();
+/// let f: Vec<f64> = v.iter().map(|&s| truth.stribeck(s)).collect();
+/// let fit = fit_static(&v, &f, &StaticFitOptions::default()).unwrap();
+/// assert!((fit.positive.set.fs - 60.2).abs() < 1e-3);
+/// assert!((fit.negative.set.vs - 0.01).abs() < 1e-6);
+/// ```
+pub fn fit_static(v: &[f64], f: &[f64], opts: &StaticFitOptions) -> Result<StaticFit> {
+    check_len("f", f, v.len(), "v")?;
+    if v.is_empty() {
+        return Err(Error::input(
+            "v",
+            "is empty: give steady-state (v, F) points",
+        ));
+    }
+    check_finite("v", v)?;
+    check_finite("f", f)?;
+    opts.weighting.validate()?;
+    if !(opts.scale_floor >= 0.0 && opts.scale_floor.is_finite()) {
+        return Err(Error::parameter(
+            "scale_floor",
+            opts.scale_floor,
+            "must be finite and zero or greater",
+        ));
+    }
+    let n_zero = v.iter().filter(|x| **x == 0.0).count();
+    if n_zero == v.len() {
+        return Err(Error::Data(
+            "every speed is zero: the Stribeck curve needs constant-velocity points in both directions".into(),
+        ));
+    }
+    let split = |pos: bool| -> (Vec<f64>, Vec<f64>, Vec<usize>) {
+        let mut a = Vec::new();
+        let mut y = Vec::new();
+        let mut idx = Vec::new();
+        for (k, (&vk, &fk)) in v.iter().zip(f).enumerate() {
+            if (pos && vk > 0.0) || (!pos && vk < 0.0) {
+                a.push(vk.abs());
+                y.push(if pos { fk } else { -fk });
+                idx.push(k);
+            }
+        }
+        (a, y, idx)
+    };
+    let (ap, yp, ip) = split(true);
+    let (an, yn, in_) = split(false);
+    if ap.is_empty() || an.is_empty() {
+        let (have, miss) = if ap.is_empty() {
+            ("v < 0", "v > 0")
+        } else {
+            ("v > 0", "v < 0")
+        };
+        return Err(Error::Data(format!(
+            "only one direction of motion in the data ({have}): add constant-velocity points with {miss}, each direction has its own friction parameters"
+        )));
+    }
+    for (label, a) in [("v > 0", &ap), ("v < 0", &an)] {
+        if a.len() < MIN_POINTS_PER_DIRECTION {
+            return Err(Error::Data(format!(
+                "{} points with {label}: at least {MIN_POINTS_PER_DIRECTION} are needed for the 4 Stribeck parameters; add constant-velocity runs in that direction",
+                a.len()
+            )));
+        }
+    }
+    let mut notes = Vec::new();
+    let pos = fit_direction(&ap, &yp, 1.0, ip, opts, &mut notes, "positive")?;
+    let neg = fit_direction(&an, &yn, -1.0, in_, opts, &mut notes, "negative")?;
+    let mut weights = vec![0.0; v.len()];
+    for d in [&pos, &neg] {
+        for (&k, &w) in d.indices.iter().zip(&d.weights) {
+            weights[k] = w;
+        }
+    }
+    let mut rejected: Vec<usize> = (0..v.len())
+        .filter(|&k| v[k] != 0.0 && weights[k] == 0.0)
+        .collect();
+    rejected.sort_unstable();
+    Ok(StaticFit {
+        positive: pos,
+        negative: neg,
+        weights,
+        rejected,
+        n_zero_speed: n_zero,
+        weighting: opts.weighting.name().to_string(),
+        notes,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn data_errors() {
+        let o = StaticFitOptions::default();
+        let e = fit_static(&[0.0, 0.0], &[1.0, 2.0], &o).unwrap_err();
+        assert!(matches!(e, Error::Data(_)), "{e}");
+        let v = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6];
+        let e = fit_static(&v, &v, &o).unwrap_err();
+        assert!(e.to_string().contains("one direction"), "{e}");
+        let v = [0.1, 0.2, 0.3, 0.4, 0.5, -0.6];
+        let e = fit_static(&v, &v, &o).unwrap_err();
+        assert!(e.to_string().contains("1 points with v < 0"), "{e}");
+        let e = fit_static(&[0.1], &[1.0, 2.0], &o).unwrap_err();
+        assert!(matches!(e, Error::Input { .. }));
+        let e = fit_static(&[0.1, f64::NAN], &[1.0, 2.0], &o).unwrap_err();
+        assert!(matches!(e, Error::Input { .. }));
+    }
+
+    #[test]
+    fn exact_curve_recovered_with_zero_speeds() {
+        let tp = StaticSet::new(10.0, 15.0, 50.0, 0.02).unwrap();
+        let tn = StaticSet::new(12.0, 14.0, 40.0, 0.05).unwrap();
+        let mut v = vec![0.0];
+        let mut f = vec![0.3];
+        for k in 0..15 {
+            let s = 1e-3 * 500f64.powf(k as f64 / 14.0);
+            v.push(s);
+            f.push(tp.stribeck(s));
+            v.push(-s);
+            f.push(tn.stribeck(-s));
+        }
+        let fit = fit_static(&v, &f, &StaticFitOptions::default()).unwrap();
+        assert_eq!(fit.n_zero_speed, 1);
+        assert_eq!(fit.weights[0], 0.0);
+        assert!(fit.rejected.is_empty(), "{:?}", fit.rejected);
+        let p = fit.positive.set;
+        let n = fit.negative.set;
+        assert!(
+            (p.fc - 10.0).abs() < 1e-4 && (p.vs - 0.02).abs() < 1e-7,
+            "{p:?}"
+        );
+        assert!(
+            (n.fs - 14.0).abs() < 1e-4 && (n.sigma2 - 40.0).abs() < 1e-3,
+            "{n:?}"
+        );
+        assert!(fit.negative.residuals.iter().all(|e| e.abs() < 1e-5));
+    }
+}
