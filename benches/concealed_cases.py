@@ -80,7 +80,7 @@ def main() -> None:
             "delay": {"effect": "delay", "seconds": 0.0008},
             "current_lag": {"effect": "current_lag", "bandwidth": 90.0},
             "deadband": {"effect": "deadband", "current": 0.06 * fc / ax.force_constant},
-            "drag": {"effect": "drag", "coefficient": 0.1 * fc / 0.04},
+            "drag": {"effect": "drag", "coefficient": 0.1 * fc / 0.1**2},  # 10 % fc at 0.1 m/s
             "stribeck_shape": {"effect": "stribeck_shape", "exponent": 1.1},
             "resonance": {"effect": "resonance", "frequency": 26.0, "damping_ratio": 0.05,
                           "load_fraction": 0.7},
