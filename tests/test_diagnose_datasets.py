@@ -18,7 +18,8 @@ pytestmark = pytest.mark.skipif(
 )
 
 
-@pytest.mark.parametrize("case", ["none", "cogging", "position_friction"])
+@pytest.mark.parametrize("case", ["none", "cogging", "position_friction", "deadband", "drag",
+                                  "stribeck_shape", "resonance"])
 def test_mismatch_case(case):
     d = MISMATCH / case
     truth = json.loads((d / "truth.json").read_text())["effects"]
@@ -37,6 +38,18 @@ def test_mismatch_case(case):
             assert f.parameters["pitch"] == pytest.approx(e["pitch"], rel=0.01)
             assert f.parameters["amplitude"] == pytest.approx(e["amplitude"], rel=0.1)
             assert f.parameters["phase"] == pytest.approx(e["phase"], abs=0.1)
+        p = f.parameters
+        if e["effect"] == "deadband":
+            assert p["current"] == pytest.approx(e["current"], rel=0.3)
+        if e["effect"] == "drag":
+            assert p["coefficient"] == pytest.approx(e["coefficient"], rel=0.3)
+        if e["effect"] == "stribeck_shape":
+            assert p["exponent"] == pytest.approx(e["exponent"], rel=0.2)
+        if e["effect"] == "resonance":
+            assert p["frequency"] == pytest.approx(e["frequency"], rel=0.15)
+            for k in ("frequency", "damping_ratio", "load_fraction"):
+                lo, hi = f.uncertainty[k]  # the held-out profile's interval holds the truth
+                assert lo <= e[k] <= hi, (k, lo, hi)
         if e["effect"] == "position_friction":
             aug = dg.augmented_model()
             pf = next(x for x in aug.effects if x["effect"] == "position_friction")
@@ -61,3 +74,20 @@ def test_emps_laps():
     after = dg.fit["holdout_after"]["nrmse_force"]
     assert before < 0.0408  # per-direction LuGre base beats the symmetric benchmark model
     assert after <= before
+
+
+def test_clean_record_holds_the_presliding_parameters():
+    """On the clean record sigma0 and sigma1 stay where the model has them (the old
+    half-sample lag of the bristles moved sigma1 by +150 %), the base moves within its
+    tolerance, and the report says what the record could have hidden."""
+    d = MISMATCH / "none"
+    dg = diagnose(lugre.read_recording(d / "recording.csv"), lugre.load_model(d / "model.json"),
+                  closed_loop=False)
+    assert dg.findings == []
+    assert "not determined" in dg.base["sigma1"]["status"]
+    assert abs(dg.base["sigma1"]["change"]) < 0.1
+    assert all(abs(b["change"]) < 2 * b["tolerance"] for b in dg.base.values())
+    hidden = {h["effect"]: h for h in dg.could_not_reveal}
+    assert {"offset", "mass", "drag", "deadband", "cogging"} <= set(hidden)
+    assert 0 < hidden["mass"]["smallest"] < 1.0  # kg: a 1 kg payload would be seen
+    assert dg.verdict.startswith("Nothing found")

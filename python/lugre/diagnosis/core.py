@@ -264,14 +264,14 @@ def diagnose(
                   accepted[min(k, len(accepted) - 1)] if accepted else {})
         extra = t.cand.describe(t.h, betas[k], ctx)
         unc: dict[str, Any] = t.cand.uncertainty(t, betas[k], ctx, sig, s2)
-        sds = intervals.get(t.effect, {})
-        for name, sd in sds.items():
-            if name not in unc and isinstance(effs[0].get(name), (int, float)):
-                v = float(effs[0][name])
-                unc[name] = [v - 1.96 * sd, v + 1.96 * sd]
-        if sds:
-            unc.setdefault("interval", "95 %, jackknife over the held-out blocks (noise "
-                                       "only, not model error)")
+        jack = [n for n, sd in intervals.get(t.effect, {}).items()
+                if n not in unc and isinstance(effs[0].get(n), (int, float))]
+        for name in jack:
+            v, sd = float(effs[0][name]), intervals[t.effect][name]
+            unc[name] = [v - 1.96 * sd, v + 1.96 * sd]
+        if jack:
+            unc["interval"] = (f"{', '.join(jack)}: 95 %, jackknife over the held-out blocks "
+                               "(noise only, not model error)")
         if t.effect == "drift":
             unc, extra = V.drift_identifiability(t, float(sig.t[sig.mask][-1]), thr=min_gain)
         if t.effect == "offset":

@@ -439,8 +439,7 @@ class _Secant(Candidate):
         return out
 
     def interval_params(self, hs: list[Any], ok: np.ndarray) -> dict[str, list[float]]:
-        vals = np.array([float(h) for h in hs])[ok]
-        return {self.param: [float(vals.min()), float(vals.max())]}
+        return _grid_interval({self.param: np.array([float(h) for h in hs])}, ok)
 
     param = ""
 
@@ -545,9 +544,9 @@ class Resonance(_Secant):
                 "load_fraction": float(r)}
 
     def interval_params(self, hs: list[Any], ok: np.ndarray) -> dict[str, list[float]]:
-        a = np.array([list(h) for h in hs], dtype=float)[ok]
-        return {k: [float(a[:, j].min()), float(a[:, j].max())]
-                for j, k in enumerate(("frequency", "damping_ratio", "load_fraction"))}
+        a = np.array([list(h) for h in hs], dtype=float)
+        return _grid_interval({k: a[:, j] for j, k in
+                               enumerate(("frequency", "damping_ratio", "load_fraction"))}, ok)
 
     def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
         f, z, r = h
@@ -565,6 +564,20 @@ class Resonance(_Secant):
         keep = f <= ctx.sig.cutoff_hz
         return {"x": f[keep], "xlabel": "frequency [Hz]", "residual": np.sqrt(pr[keep]),
                 "effect": np.sqrt(pe[keep]), "ylabel": "force density [N/sqrt(Hz)]"}
+
+
+def _grid_interval(values: dict[str, np.ndarray], ok: np.ndarray) -> dict[str, list[float]]:
+    """Range of each parameter over the grid points whose held-out score is within the
+    threshold of the best, widened to the neighbouring grid values: the grid's spacing
+    bounds what the profile can say (one point alone is no interval)."""
+    out = {}
+    for name, v in values.items():
+        grid = np.unique(v)
+        lo, hi = float(v[ok].min()), float(v[ok].max())
+        below, above = grid[grid < lo], grid[grid > hi]
+        out[name] = [float(below.max()) if below.size else lo,
+                     float(above.min()) if above.size else hi]
+    return out
 
 
 def candidates() -> list[Candidate]:

@@ -97,7 +97,8 @@ def refine(model: Model, sig: R.Signals, terms: list[Term], base: dict[str, floa
         for k, t in enumerate(terms):
             h, b = t.cand.recenter(t.h, betas[k], ctx)
             if h is not t.h:
-                terms[k] = Term(cand=t.cand, h=h, X=t.X, prior=t.prior, center=t.center)
+                terms[k] = Term(cand=t.cand, h=h, X=t.X, prior=t.prior, center=t.center,
+                                profile=t.profile)
                 betas[k] = b
         base = {n: B.get_base(aug, n) for n, _ in B.BASE_PARAMS}
         r = R.residual(aug, sig)

@@ -206,7 +206,8 @@ class Diagnosis:
             lines.append("Base parameters re-estimated: " + ", ".join(moved) + ".")
         if self.could_not_reveal:
             lines.append("What this record could have hidden: " + "; ".join(
-                h["text"] for h in self.could_not_reveal) + ".")
+                h["text"] + (f" ({h['experiment']})" if h.get("experiment") else "")
+                for h in self.could_not_reveal) + ".")
         if self.unexplained:
             u = self.unexplained
             lines.append(f"Unexplained: {u['message']}")
