@@ -210,18 +210,10 @@ def check_recording(rec: Recording, model: Model | None = None) -> None:
         )
     if rec.i is None and rec.F is None:  # pragma: no cover - Recording refuses it
         raise InputError.at("i", "the recording has neither the current i nor the force F")
-    dts = np.diff(rec.t)
-    med = float(np.median(dts))
-    long = np.flatnonzero(dts > 1.5 * med * 1.0001 + 1e-12)
-    if long.size:
-        j = int(long[np.argmax(dts[long])])
-        raise DataError(
-            f"the sampling of the recording has {long.size} gap(s) longer than 1.5 times the "
-            f"sample interval {med:.4g} s (the longest {dts[j]:.4g} s after t = "
-            f"{rec.t[j]:.6g} s, data row {j + 1}): derivatives across a gap are meaningless. "
-            "Diagnose each gap-free stretch separately, or resample onto a uniform grid "
-            "(lugre diagnose --resample) if the gaps are short against the motion"
-        )
+    from ..checks import require_plausible
+
+    require_plausible(rec)  # gaps in the sampling, positions in the wrong unit
+    med = float(np.median(np.diff(rec.t)))
     span = float(np.ptp(rec.x))
     steps = np.abs(np.diff(rec.x))
     q = float(np.min(steps[steps > 0])) if np.any(steps > 0) else 0.0
@@ -232,13 +224,6 @@ def check_recording(rec: Recording, model: Model | None = None) -> None:
         )
     v = np.diff(rec.x) / med
     vmax = float(np.max(np.abs(v)))
-    if vmax > 20.0 or span > 20.0:
-        raise DataError(
-            f"the positions span {span:.4g} and the speed reaches {vmax:.4g} per second: "
-            "this looks like millimetres (or counts), but positions are in metres. Convert "
-            "x to metres: --x-unit mm, or a column expression such as --columns "
-            "'x=x/1000'"
-        )
     if model is not None:
         vs = min(model.positive["vs"], model.negative["vs"])
         if np.percentile(np.abs(v), 90) > 1000 * vs and vmax > 5.0:
