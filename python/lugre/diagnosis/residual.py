@@ -468,10 +468,10 @@ def coupling_force(model: Model, sig: Signals) -> np.ndarray:
     load, the load simulated along the filtered motor motion with its friction (and the
     friction scales) and the effect forces on it (``lugre.load_coupling``)."""
     # the motion that drives the bristles of the rigid model, and substeps so that the
-    # load's bristles trail the samples by 1/16 of an interval, not by half of one
+    # load's bristles trail the samples by 1/8 of an interval, not by half of one
     return load_coupling(sig.info["x_drive"], sig.v, sig.dt, model,
                          scale=friction_scale(model, sig), extra=effect_force(model, sig),
-                         substeps=8).force
+                         substeps=4).force
 
 
 def total_mass(model: Model) -> float:

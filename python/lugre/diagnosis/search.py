@@ -195,9 +195,18 @@ class Scorer:
 
 
 def make_term(c: Candidate, h: Any, ctx: Context) -> Term:
-    """Build a :class:`Term` with its columns and prior."""
-    return Term(cand=c, h=h, X=c.columns(h, ctx), prior=c.prior_tol(h, ctx),
-                center=c.prior_center(h, ctx))
+    """Build a :class:`Term` with its columns and prior.
+
+    The columns depend on the candidate, its parameter and the context's base model only,
+    so they are kept on the context: the forward selection profiles the same grids at
+    every step.
+    """
+    key = ("columns", c.effect, h if isinstance(h, (tuple, str)) or h is None else float(h))
+    cache = ctx.extra.setdefault(("cache", id(ctx.model)), {})
+    X = cache.get(key)
+    if X is None:
+        X = cache[key] = c.columns(h, ctx)
+    return Term(cand=c, h=h, X=X, prior=c.prior_tol(h, ctx), center=c.prior_center(h, ctx))
 
 
 def _profile(scorer: Scorer, kept: list[Term], c: Candidate, grid: np.ndarray, ctx: Context
