@@ -218,3 +218,21 @@ def test_bristles_at_the_sample_instants():
     e_new = np.sqrt(np.mean((new - true)[k] ** 2))
     e_old = np.sqrt(np.mean((old - true)[k] ** 2))
     assert e_new < 0.3 * e_old, (e_new, e_old)
+
+
+def test_physics_outside_the_vocabulary_is_unexplained():
+    """A force-constant ripple along the stroke (the recorded current is the actual one
+    times 1 + 5 % sin(2 pi x / 30 mm)) is no effect of the vocabulary: position_friction
+    resembles it in part, but the rest stays far above the noise, so the diagnosis says
+    unexplained, where, and what it resembles, and names nothing."""
+    from lugre.diagnosis.synth import case
+
+    rec, _hold, believed, _ = case([], seed=900, kind="sines", duration=20.0)
+    g = 1 + 0.05 * np.sin(2 * np.pi * rec.x / 0.03)
+    rec = lugre.Recording(t=rec.t, x=rec.x, i=rec.i * g, x_ref=rec.x_ref)
+    dg = diagnose(rec, believed, closed_loop=False)
+    assert dg.findings == []
+    u = dg.unexplained
+    assert u is not None and u["where"]["position"]
+    assert [r["effect"] for r in u["resembles"]] == ["position_friction"]
+    assert dg.verdict.startswith("Unexplained")
