@@ -429,7 +429,9 @@ def verdict(dg: Any) -> str:
                    "vocabulary accounts for it. " + dg.unexplained["message"])
         return txt + gain
     names = ", ".join(f"{f.effect} ({_params(f)})" for f in dg.findings)
-    txt = f"Found: {names}.{gain} Add them to the model (the augmented model has them)."
+    one = len(dg.findings) == 1
+    txt = (f"Found: {names}.{gain} Add {'it' if one else 'them'} to the model (the augmented "
+           f"model has {'it' if one else 'them'}).")
     if any(f.alternatives for f in dg.findings):
         txt += " Some have a look-alike this record cannot rule out: see each finding."
     if dg.unexplained:
