@@ -125,3 +125,19 @@ pub fn check_len(name: &str, a: &[f64], n: usize, of: &str) -> Result<()> {
     }
     Ok(())
 }
+
+/// A per-sample friction `scale` (the `s` of `g`): as long as `of`, finite, positive.
+pub fn check_scale(sc: &[f64], n: usize, of: &str) -> Result<()> {
+    check_len("scale", sc, n, of)?;
+    check_finite("scale", sc)?;
+    if let Some(k) = sc.iter().position(|&s| s <= 0.0) {
+        return Err(Error::input(
+            "scale",
+            format!(
+                "element {k} is {}: the friction scale must be greater than zero",
+                sc[k]
+            ),
+        ));
+    }
+    Ok(())
+}

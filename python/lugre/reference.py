@@ -80,6 +80,19 @@ def _check_len(name: str, a: list[float], n: int, of: str) -> None:
         )
 
 
+def _check_scale(sc: list[float], n: int, of: str) -> None:
+    """A per-sample friction ``scale``: as long as ``of``, finite, positive (``check_scale``
+    in error.rs)."""
+    _check_len("scale", sc, n, of)
+    _check_finite("scale", sc)
+    for k, x in enumerate(sc):
+        if x <= 0.0:
+            raise InputError.at(
+                "scale",
+                f"element {k} is {_fmt_f64(x)}: the friction scale must be greater than zero",
+            )
+
+
 def _finite_option(name: str, value: Any) -> float:
     try:
         x = float(value)
@@ -284,15 +297,7 @@ def friction_force(
     z = _finite_option("z0", z0)
     n = len(vv)
     if sc is not None:
-        _check_len("scale", sc, n, "v")
-        _check_finite("scale", sc)
-        for k, x in enumerate(sc):
-            if x <= 0.0:
-                raise InputError.at(
-                    "scale",
-                    f"element {k} is {_fmt_f64(x)}: the friction scale must be greater "
-                    "than zero",
-                )
+        _check_scale(sc, n, "v")
     out = [0.0] * n
     zs = [0.0] * n
     h = dts[0]
@@ -930,15 +935,7 @@ def load_coupling(
     if substeps < 1:
         raise ParameterError.invalid("substeps", 0.0, "must be at least 1")
     if sc is not None:
-        _check_len("scale", sc, n, "x")
-        _check_finite("scale", sc)
-        for k, s in enumerate(sc):
-            if s <= 0.0:
-                raise InputError.at(
-                    "scale",
-                    f"element {k} is {_fmt_f64(s)}: the friction scale must be greater "
-                    "than zero",
-                )
+        _check_scale(sc, n, "x")
     if ex is not None:
         _check_len("extra", ex, n, "x")
         _check_finite("extra", ex)

@@ -159,7 +159,7 @@ fn friction_force<'py>(
             return Err(Error::parameter("z0", z0, "must be finite"));
         }
         if let Some(sc) = sc {
-            check_scale(sc, vs.len())?;
+            crate::error::check_scale(sc, vs.len(), "v")?;
         }
         Ok(())
     })()
@@ -234,22 +234,6 @@ fn load_coupling<'py>(
         r.v.into_pyarray(py),
         r.z.into_pyarray(py),
     ))
-}
-
-/// `scale` of `friction_force`: one positive finite factor per sample.
-fn check_scale(sc: &[f64], n: usize) -> Result<(), Error> {
-    crate::error::check_len("scale", sc, n, "v")?;
-    check_finite("scale", sc)?;
-    if let Some(k) = sc.iter().position(|&s| s <= 0.0) {
-        return Err(Error::input(
-            "scale",
-            format!(
-                "element {k} is {}: the friction scale must be greater than zero",
-                sc[k]
-            ),
-        ));
-    }
-    Ok(())
 }
 
 fn parse_opts(

@@ -25,7 +25,7 @@
 
 use super::model::{Effect, Model};
 use super::sim::TwoMass;
-use crate::error::{check_finite, check_len, Error, Result};
+use crate::error::{check_finite, check_len, check_scale, Error, Result};
 use crate::friction::LugreParams;
 
 /// Most substeps allowed per sample interval (a guard against absurd `dt`).
@@ -179,17 +179,7 @@ fn check_inputs(
         return Err(Error::parameter("substeps", 0.0, "must be at least 1"));
     }
     if let Some(sc) = opts.scale {
-        check_len("scale", sc, x.len(), "x")?;
-        check_finite("scale", sc)?;
-        if let Some(k) = sc.iter().position(|&s| s <= 0.0) {
-            return Err(Error::input(
-                "scale",
-                format!(
-                    "element {k} is {}: the friction scale must be greater than zero",
-                    sc[k]
-                ),
-            ));
-        }
+        check_scale(sc, x.len(), "x")?;
     }
     if let Some(ex) = opts.extra {
         check_len("extra", ex, x.len(), "x")?;
