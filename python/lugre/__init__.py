@@ -80,22 +80,22 @@ def diagnose(recording: Any, model: Any, **kwargs: Any) -> Any:
     from .diagnosis import diagnose as _diagnose
     from .tabular import as_recording
 
-    rec = require_plausible(as_recording(recording))
+    # the recording is checked first thing by the diagnosis; the hold-out only at its
+    # end, so it is checked here, before the work
     hold = kwargs.get("holdout")
     if hold is not None:
         kwargs["holdout"] = require_plausible(as_recording(hold, "holdout"))
-    return _diagnose(rec, model, **kwargs)
+    return _diagnose(as_recording(recording), model, **kwargs)
 
 
 def evaluate(recording: Any, model: Any, **kwargs: Any) -> Any:
     """The inverse-dynamics force residual of ``model`` on ``recording`` (``rms_force``
     [N], ``nrmse_force``, ...). ``recording`` is taken as by :func:`diagnose`; see
     :func:`lugre.diagnosis.evaluate`."""
-    from .checks import require_plausible
     from .diagnosis import evaluate as _evaluate
     from .tabular import as_recording
 
-    return _evaluate(require_plausible(as_recording(recording)), model, **kwargs)
+    return _evaluate(as_recording(recording), model, **kwargs)  # checked by the diagnosis
 
 
 def _table_or_same(recording: Any) -> Any:

@@ -65,15 +65,13 @@ def lowpass(y: np.ndarray, cutoff_hz: float, fs: float, order: int = 4) -> np.nd
     wn = cutoff_hz / (0.5 * fs)
     if wn >= 0.99:
         return np.array(y, dtype=float, copy=True)
-    return signal.sosfiltfilt(_butter(order, wn).copy(), y, axis=0, padtype="odd",
+    return signal.sosfiltfilt(_butter(order, wn), y, axis=0, padtype="odd",
                               padlen=min(3 * 24, len(y) - 1))
 
 
 @functools.lru_cache(maxsize=16)
 def _butter(order: int, wn: float) -> np.ndarray:
-    sos = signal.butter(order, wn, output="sos")
-    sos.flags.writeable = False
-    return sos
+    return signal.butter(order, wn, output="sos")  # (sosfiltfilt does not write to it)
 
 
 def hampel(y: np.ndarray, half_window: int = 5, k: float = 5.0) -> tuple[np.ndarray, np.ndarray]:

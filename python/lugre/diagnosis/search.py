@@ -371,12 +371,9 @@ def forward_select(
                 term, ev = _profile(scorer, kept, c, grid, ctx)
                 h = term.h
             else:
-                if c.effect == "cogging":
-                    h = c.choose(cur.resid, ctx)
-                    if h is None:
-                        continue
-                else:
-                    h = c.choose(cur.resid, ctx)
+                h = c.choose(cur.resid, ctx)
+                if h is None and c.effect == "cogging":
+                    continue  # no pitch the record resolves
                 term = make_term(c, h, ctx)
                 ev = scorer.evaluate(kept + [term])
             trial = kept + [term]
