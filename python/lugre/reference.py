@@ -25,11 +25,20 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ._reference_inverse import InverseRecord
 from ._result import CouplingResult, SimResult
 from .exceptions import DataError, InputError, ModelError, ParameterError, _fmt_f64
 from .model import ModelLike, _as_model, _CurrentLoop, _Friction, _Parsed, _StaticSet
 
-__all__ = ["CouplingResult", "SimResult", "friction_force", "load_coupling", "simulate", "stribeck"]
+__all__ = [
+    "CouplingResult",
+    "InverseRecord",
+    "SimResult",
+    "friction_force",
+    "load_coupling",
+    "simulate",
+    "stribeck",
+]
 
 _PI = math.pi
 _exp = math.exp
