@@ -52,17 +52,33 @@ class Term:
 
 @dataclass
 class Evaluation:
-    """Scores of one candidate model."""
+    """Scores of one candidate model (``fitted`` and ``resid`` computed when asked:
+    the search scores hundreds of fits and looks at the residual of a few)."""
 
     score: float
     sse_b: np.ndarray
     prior: float
     beta: np.ndarray
-    fitted: np.ndarray
-    resid: np.ndarray
     sse: float
     splits: list[slice] = field(default_factory=list)
     jack: np.ndarray | None = None
+    r: np.ndarray | None = None
+    J: np.ndarray | None = None
+    X: np.ndarray | None = None
+
+    @property
+    def fitted(self) -> np.ndarray:
+        """The fitted change of the residual, ``J @ beta_base + X @ beta_effects`` [N]."""
+        assert self.J is not None and self.X is not None
+        q = self.J.shape[1]
+        out = self.J @ self.beta[:q]
+        return out + self.X @ self.beta[q:] if self.X.shape[1] else out
+
+    @property
+    def resid(self) -> np.ndarray:
+        """The residual left by the fit [N]."""
+        assert self.r is not None
+        return self.r - self.fitted
 
 
 class Scorer:
@@ -188,10 +204,9 @@ class Scorer:
             sse_b[k] = rr_b[k] - 2 * bk @ h_b[k] + bk @ G_b[k] @ bk
             jack[k] = bk / sc
         beta = b / sc
-        fitted = self.J @ beta[:q] + (X @ beta[q:] if p else 0.0)
         score = float(sse_b.sum() / self.s2 + prior)
-        return Evaluation(score=score, sse_b=sse_b, prior=prior, beta=beta, fitted=fitted,
-                          resid=self.r - fitted, sse=sse, splits=self.blocks, jack=jack)
+        return Evaluation(score=score, sse_b=sse_b, prior=prior, beta=beta, sse=sse,
+                          splits=self.blocks, jack=jack, r=self.r, J=self.J, X=X)
 
 
 def make_term(c: Candidate, h: Any, ctx: Context) -> Term:
