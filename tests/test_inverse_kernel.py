@@ -188,3 +188,15 @@ def test_diagnose_same_on_both_backends():
     for k in pa:
         if isinstance(pa[k], float):
             assert pa[k] == pytest.approx(pb[k], rel=1e-8, abs=1e-12), k
+
+
+@pytest.mark.parametrize("backend", ["core", "reference"])
+def test_residuals_batch_as_one_by_one(pair, backend):
+    sig = pair[0] if backend == "core" else pair[1]
+    model = pair[2]
+    models = [model.replace(effects=EFFECTS[c]) for c in ("plain", "cogging", "resonance")]
+    batch = sig.kernel.residuals(models)
+    assert batch.shape == (len(sig), 3)
+    for j, m in enumerate(models):
+        np.testing.assert_array_equal(batch[:, j], sig.kernel.residual(m))
+    assert sig.kernel.residuals([]).shape == (len(sig), 0)

@@ -342,6 +342,12 @@ class InverseRecord:
         m = _as_model(model)
         return self.motor_force(m) - self.model_force(m)
 
+    def residuals(self, models: list[ModelLike]) -> np.ndarray:
+        """Residuals of several models, one column each."""
+        if not models:
+            return np.zeros((len(self), 0))
+        return np.column_stack([self.residual(m) for m in models])
+
     def base_sensitivities(self, model: ModelLike, names: list[str]
                            ) -> tuple[np.ndarray, np.ndarray, list[bool]]:
         """``(force, J, nonzero)``: the LuGre force, its filtered derivatives with respect

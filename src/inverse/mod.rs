@@ -432,6 +432,13 @@ impl Record {
         Ok(r)
     }
 
+    /// [`Record::residual`] of several models, in parallel (rayon); the first error
+    /// in the order of `models` when any fails.
+    pub fn residuals(&self, models: &[Model]) -> Result<Vec<Vec<f64>>> {
+        use rayon::prelude::*;
+        models.par_iter().map(|m| self.residual(m)).collect()
+    }
+
     /// The LuGre force of [`Record::base_friction`] and its filtered derivatives with
     /// respect to `params`, propagated exactly through the bristle update.
     pub fn base_sensitivities(&self, model: &Model, params: &[BaseParam]) -> Sensitivities {
@@ -649,6 +656,22 @@ mod tests {
         .unwrap();
         let r = rec2.residual(&m).unwrap();
         assert!(r.iter().all(|x| x.abs() < 1e-9));
+    }
+
+    #[test]
+    fn residuals_in_parallel_as_one_by_one() {
+        let rec = record(800);
+        let mut models = vec![Model::paper(); 3];
+        models[1].effects.push(Effect::Offset { force: 3.0 });
+        models[2].effects.push(Effect::Resonance {
+            frequency_hz: 20.0,
+            damping_ratio: 0.05,
+            load_fraction: 0.5,
+        });
+        let all = rec.residuals(&models).unwrap();
+        for (m, r) in models.iter().zip(&all) {
+            assert_eq!(&rec.residual(m).unwrap(), r);
+        }
     }
 
     #[test]

@@ -216,6 +216,35 @@ impl PyInverseRecord {
         Ok(r.into_pyarray(py))
     }
 
+    /// Residuals of several models (one column each), computed in parallel.
+    fn residuals<'py>(
+        &self,
+        py: Python<'py>,
+        models: Vec<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let ms = models
+            .iter()
+            .map(|m| model_of(py, m).map(|m| (*m).clone()))
+            .collect::<PyResult<Vec<_>>>()?;
+        let n = self.rec.len();
+        let q = ms.len();
+        let flat = py
+            .detach(|| -> Result<Vec<f64>, Error> {
+                let rs = self.rec.residuals(&ms)?;
+                let mut flat = vec![0.0; n * q];
+                for (j, c) in rs.iter().enumerate() {
+                    for (k, &x) in c.iter().enumerate() {
+                        flat[k * q + j] = x;
+                    }
+                }
+                Ok(flat)
+            })
+            .map_err(|e| to_py(py, e))?;
+        let out = Array2::from_shape_vec((n, q), flat)
+            .map_err(|e| to_py(py, Error::input("models", e.to_string())))?;
+        Ok(out.into_pyarray(py))
+    }
+
     /// `(force, J, nonzero)`: the unfiltered LuGre force, its filtered derivatives with
     /// respect to the named parameters (one column each) and whether each unfiltered
     /// column is non-zero.
