@@ -210,7 +210,7 @@ def test_bristles_at_the_sample_instants():
     s = lugre.simulate(m, t, current=i)
     rec = lugre.Recording(t=t[::10], x=s.x[::10], i=i[::10])
     sig = R.prepare(rec, m, drive_cutoff_hz=499.0)
-    sig.v = s.v[::10].copy()  # the exact velocity: only the bristle timing differs
+    sig = sig.with_drive(s.v[::10])  # the exact velocity: only the bristle timing differs
     new = R.base_friction(m, sig)
     old = lugre.friction_force(sig.v, sig.dt, m)
     true = s.friction[::10]

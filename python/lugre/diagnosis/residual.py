@@ -17,7 +17,7 @@ from __future__ import annotations
 import functools
 import math
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -123,7 +123,7 @@ def hampel(y: np.ndarray, half_window: int = 5, k: float = 5.0) -> tuple[np.ndar
     return out, spikes
 
 
-@dataclass
+@dataclass(frozen=True)
 class Signals:
     """A recording prepared for inverse dynamics (all arrays of the recording's length).
 
@@ -193,6 +193,15 @@ class Signals:
 
     def __len__(self) -> int:
         return int(self.t.size)
+
+    def with_drive(self, v: np.ndarray) -> Signals:
+        """A copy whose bristles are driven by the velocity ``v`` (its kernel rebuilt:
+        the signals are frozen, the kernel holds its own copy of them)."""
+        v = np.ascontiguousarray(v, dtype=float)
+        sos, padlen = self.info["filter"]
+        kernel = type(self.kernel)(self.t, self.x, self.info["x_drive"], v, self.a, self.fm,
+                                   self.fm_f, self.dt, sos, padlen)
+        return replace(self, v=v, kernel=kernel)
 
 
 def check_recording(rec: Recording, model: Model | None = None) -> None:
@@ -321,12 +330,14 @@ def prepare(
         raise InputError.at("backend", f"unknown backend {backend!r}: use \"core\" or "
                             "\"reference\"")
     x, xd, v, a, fm, fm_f = (np.ascontiguousarray(u, dtype=float) for u in (x, xd, v, a, fm, fm_f))
-    kernel = kernel_cls(np.ascontiguousarray(tt, dtype=float), x, xd, v, a, fm, fm_f, dt, sos,
-                        min(_PADLEN, n - 1))
+    tt = np.ascontiguousarray(tt, dtype=float)
+    padlen = min(_PADLEN, n - 1)
+    kernel = kernel_cls(tt, x, xd, v, a, fm, fm_f, dt, sos, padlen)
     return Signals(t=tt, dt=dt, fs=fs, cutoff_hz=fc, x=x, v=v, vf=vf, a=a, fm=fm,
                    fm_f=fm_f, dfm=dfm, spikes=spikes, mask=mask, x_raw=rec.x.copy(),
                    force_raw=force_raw, recording=rec,
-                   info={"drive_cutoff_hz": fd, "quantum": q, "edge": edge, "x_drive": xd},
+                   info={"drive_cutoff_hz": fd, "quantum": q, "edge": edge, "x_drive": xd,
+                         "filter": (sos, padlen)},
                    kernel=kernel, backend=mod)
 
 
