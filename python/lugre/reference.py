@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from bisect import bisect_right
 from collections import deque
+from collections.abc import Sequence
 from numbers import Integral
 from typing import Any, Callable
 
@@ -27,9 +28,49 @@ import numpy as np
 
 from ._result import CouplingResult, SimResult
 from .exceptions import DataError, InputError, ModelError, ParameterError, _fmt_f64
-from .model import ModelLike, _as_model, _CurrentLoop, _Friction, _Parsed, _StaticSet
+from .model import (
+    ModelLike,
+    _as_model,
+    _CurrentLoop,
+    _Friction,
+    _parse,
+    _Parsed,
+    _StaticSet,
+    load_model,
+    save_model,
+)
 
-__all__ = ["CouplingResult", "SimResult", "friction_force", "load_coupling", "simulate", "stribeck"]
+__all__ = [
+    "CouplingResult",
+    "SimResult",
+    "friction_force",
+    "load_coupling",
+    "load_model",
+    "save_model",
+    "simulate",
+    "simulate_batch",
+    "stribeck",
+]
+
+#: Names defined in the ``_reference_*`` modules, imported on first use: the
+#: identification imports the facade's result classes, whose module imports this one.
+_LAZY: dict[str, str] = {}
+
+
+def __getattr__(name: str) -> Any:
+    mod = _LAZY.get(name)
+    if mod is None:
+        raise AttributeError(f"module 'lugre.reference' has no attribute {name!r}")
+    from importlib import import_module
+
+    value = getattr(import_module(mod, __package__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
 
 _PI = math.pi
 _exp = math.exp
@@ -38,6 +79,12 @@ _exp = math.exp
 # --------------------------------------------------------------------------------------
 # Input checks (src/error.rs), raising the same information as the core
 # --------------------------------------------------------------------------------------
+
+
+def _parsed(model: ModelLike) -> _Parsed:
+    """The model's numbers, checked here from its document as the core checks its JSON:
+    a :class:`~lugre.Model` built around the checks is refused by both backends alike."""
+    return _parse(_as_model(model)._data)
 
 
 def _array(name: str, a: Any) -> np.ndarray:
@@ -219,7 +266,7 @@ def stribeck(v: Any, model: ModelLike) -> np.ndarray:
     InputError
         ``v`` is not 1-D or holds NaN or inf.
     """
-    p = _as_model(model)._parsed.friction
+    p = _parsed(model).friction
     vv = _array("v", v).tolist()
     _check_finite("v", vv)
     return np.array([_stribeck1(p, x) for x in vv], dtype=np.float64)
@@ -271,7 +318,7 @@ def friction_force(
     ParameterError
         ``z0`` not finite.
     """
-    parsed = _as_model(model)._parsed
+    parsed = _parsed(model)
     p = parsed.friction
     exponent = parsed.stribeck_exponent
     vv = _array("v", v).tolist()
@@ -646,7 +693,7 @@ def simulate(
     DataError
         The simulation diverged.
     """
-    m = _as_model(model)._parsed
+    m = _parsed(model)
     if integrator not in ("exact", "rk4"):
         raise InputError.at(
             "integrator", f'unknown integrator "{integrator}": use "exact" or "rk4"'
@@ -830,6 +877,41 @@ def simulate(
     return SimResult(ta.copy(), out_x, out_v, out_z, out_i, out_f, out_fm)
 
 
+def simulate_batch(
+    models: Sequence[ModelLike],
+    t: Any,
+    x_ref: Any = None,
+    *,
+    v_ref: Any = None,
+    current: Any = None,
+    integrator: str = "exact",
+    substeps: int = 1,
+    z0: float = 0.0,
+    x0: float | None = None,
+    v0: float = 0.0,
+) -> list[SimResult]:
+    """Simulate many models on the same input: :func:`simulate` for each, in order.
+
+    Parameters are those of :func:`simulate`, with a sequence of models. As in the core,
+    the inputs are converted and every model is checked before the first simulation,
+    and the first model that fails raises.
+
+    Returns
+    -------
+    list of SimResult
+        One per model, in order.
+    """
+    kind, drive = _select_drive(x_ref, v_ref, current)
+    _array("t", t)
+    _array(kind, drive)
+    _check_substeps_type(substeps)
+    models = list(models)
+    for m in models:
+        _parsed(m)
+    return [simulate(m, t, integrator=integrator, substeps=substeps, z0=z0, x0=x0, v0=v0,
+                     **{kind: drive}) for m in models]
+
+
 # --------------------------------------------------------------------------------------
 # The load behind the resonance coupling (src/servo/coupling.rs)
 # --------------------------------------------------------------------------------------
@@ -903,7 +985,7 @@ def load_coupling(
         The load's state turned non-finite.
     """
     # the facade's conversions, then the core's checks in the core's order
-    parsed = _as_model(model)._parsed
+    parsed = _parsed(model)
     xa = _array("x", x).tolist()
     va = _array("v", v).tolist()
     sc = None if scale is None else _array("scale", scale).tolist()
