@@ -22,7 +22,7 @@ from bisect import bisect_right
 from collections import deque
 from collections.abc import Sequence
 from numbers import Integral
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
@@ -40,9 +40,14 @@ from .model import (
     save_model,
 )
 
+if TYPE_CHECKING:  # pragma: no cover
+    from ._reference_static import StaticFit, fit_static
+
 __all__ = [
     "CouplingResult",
     "SimResult",
+    "StaticFit",
+    "fit_static",
     "friction_force",
     "load_coupling",
     "load_model",
@@ -54,7 +59,11 @@ __all__ = [
 
 #: Names defined in the ``_reference_*`` modules, imported on first use: the
 #: identification imports the facade's result classes, whose module imports this one.
-_LAZY: dict[str, str] = {}
+_LAZY = {
+    "DirectionFit": "._reference_static",
+    "StaticFit": "._reference_static",
+    "fit_static": "._reference_static",
+}
 
 
 def __getattr__(name: str) -> Any:
