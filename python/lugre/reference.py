@@ -41,12 +41,15 @@ from .model import (
 )
 
 if TYPE_CHECKING:  # pragma: no cover
+    from ._reference_dynamic import DynamicFit, fit_dynamic
     from ._reference_static import StaticFit, fit_static
 
 __all__ = [
     "CouplingResult",
+    "DynamicFit",
     "SimResult",
     "StaticFit",
+    "fit_dynamic",
     "fit_static",
     "friction_force",
     "load_coupling",
@@ -63,6 +66,8 @@ _LAZY = {
     "DirectionFit": "._reference_static",
     "StaticFit": "._reference_static",
     "fit_static": "._reference_static",
+    "DynamicFit": "._reference_dynamic",
+    "fit_dynamic": "._reference_dynamic",
 }
 
 
@@ -702,7 +707,25 @@ def simulate(
     DataError
         The simulation diverged.
     """
-    m = _parsed(model)
+    return _simulate(_parsed(model), t, x_ref, v_ref=v_ref, current=current,
+                     integrator=integrator, substeps=substeps, z0=z0, x0=x0, v0=v0)
+
+
+def _simulate(
+    m: _Parsed,
+    t: Any,
+    x_ref: Any = None,
+    *,
+    v_ref: Any = None,
+    current: Any = None,
+    integrator: str = "exact",
+    substeps: int = 1,
+    z0: float = 0.0,
+    x0: float | None = None,
+    v0: float = 0.0,
+) -> SimResult:
+    """:func:`simulate` of a parsed model (the estimators change its numbers directly,
+    as the core does, without building and checking a document each time)."""
     if integrator not in ("exact", "rk4"):
         raise InputError.at(
             "integrator", f'unknown integrator "{integrator}": use "exact" or "rk4"'
