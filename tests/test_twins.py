@@ -825,3 +825,21 @@ def test_fit_dynamic_refuses_records_without_motion_or_reference():
                 backend.fit_dynamic(r, m)
             msgs.append(str(e.value))
         assert msgs[0] == msgs[1]
+
+
+def test_fit_dynamic_twins_carry_the_static_covariance():
+    """With ``static_fit`` both refit at the static sigma points (16 refits) and widen
+    the intervals alike (the facade's Python, repeated by the twin around its own fits)."""
+    rec, m = _stick_slip_record(duration=0.2)
+    s = np.geomspace(2e-4, 0.4, 16)
+    v = np.concatenate([s, -s])
+    F = lugre.stribeck(v, m) + 0.2 * np.random.default_rng(3).standard_normal(v.size)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", lugre.LugreWarning)
+        sf = lugre.fit_static(v, F)
+        m = sf.to_model(m)
+        a = lugre.fit_dynamic(rec, m, static_fit=sf, grid=False, max_iter=1)
+        b = ref.fit_dynamic(rec, m, static_fit=sf, grid=False, max_iter=1)
+    assert_same_dynamic(a, b)
+    assert any("joint covariance carried over" in n for n in b.notes)
+    assert a.notes == b.notes

@@ -1,10 +1,19 @@
 """The NumPy reference: the algorithms of ``docs/DESIGN.md`` in plain Python.
 
-Same names, signatures and results as the Rust-backed :mod:`lugre` API, written with
-NumPy alone (no SciPy) as loops over Python floats that repeat the core's
-(``src/friction/mod.rs``, ``src/servo/sim.rs``) operations in the same order, so that
-the two agree to rounding (about 1e-12). It is slow (a few microseconds per plant step)
-and meant for checking the core and for reading.
+Same names, signatures, results and errors as the Rust-backed :mod:`lugre` API, written
+with NumPy alone (no SciPy) as loops over Python floats that repeat the core's
+(``src/friction/mod.rs``, ``src/servo/sim.rs``, ``src/estimate/``) operations in the
+same order, so that the two agree bit for bit. It is slow (a few microseconds per plant
+step) and meant for checking the core and for reading. Never calls :mod:`lugre._core`.
+
+- kernels here: :func:`stribeck`, :func:`friction_force`, :func:`simulate`,
+  :func:`simulate_batch`, :func:`load_coupling`;
+- estimators in their own modules, imported on first use: :func:`fit_static`
+  (``_reference_static``), :func:`fit_dynamic` (``_reference_dynamic``), built on
+  Nelder-Mead as the core runs it (``_reference_nm``) and the robust weights
+  (``_reference_robust``); their results are the facade's :class:`StaticFit` and
+  :class:`DynamicFit`;
+- :func:`load_model` and :func:`save_model` are the facade's own (Python) functions.
 
 Examples
 --------
