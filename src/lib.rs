@@ -11,6 +11,8 @@
 //!   axis under a PID position or PI speed controller, with friction feed-forward,
 //!   current loop and extra physics (cogging, springs, offsets, ...).
 //! - [`estimate`] (feature `std`): robust (IRLS) Nelder-Mead identification.
+//! - [`inverse`] (feature `std`): inverse dynamics of a recorded axis, the force
+//!   residual against a model and its sensitivities (the numerics of the diagnosis).
 //! - Python bindings (feature `python`), built by maturin as `lugre._core`.
 //!
 //! The numerical algorithms are fixed in `docs/DESIGN.md`; the NumPy reference
@@ -24,6 +26,8 @@ pub mod friction;
 pub mod error;
 #[cfg(feature = "std")]
 pub mod estimate;
+#[cfg(feature = "std")]
+pub mod inverse;
 #[cfg(feature = "std")]
 pub mod servo;
 

@@ -1,11 +1,13 @@
 """Type stubs of the compiled core (``lugre._core``); use the ``lugre`` package instead."""
 
-from typing import Any
+from typing import Any, TypeAlias, final
 
 import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "InverseRecord",
+    "Model",
     "__version__",
     "check_model",
     "fit_dynamic_record",
@@ -21,12 +23,49 @@ __all__ = [
 
 __version__: str
 
-def check_model(model_json: str) -> bool: ...
-def stribeck(v: npt.NDArray[np.float64], model_json: str) -> npt.NDArray[np.float64]: ...
+@final
+class Model:
+    def __new__(cls, model_json: str) -> Model: ...
+    def is_passive(self) -> bool: ...
+
+# a _core.Model, the model's JSON text, or a lugre.Model (its cached _core.Model)
+_ModelArg: TypeAlias = Model | str | Any
+
+@final
+class InverseRecord:
+    def __new__(
+        cls,
+        t: npt.NDArray[np.float64],
+        x: npt.NDArray[np.float64],
+        x_drive: npt.NDArray[np.float64],
+        v: npt.NDArray[np.float64],
+        a: npt.NDArray[np.float64],
+        fm: npt.NDArray[np.float64],
+        fm_f: npt.NDArray[np.float64],
+        dt: float,
+        sos: npt.NDArray[np.float64] | None = None,
+        padlen: int = 0,
+    ) -> InverseRecord: ...
+    def __len__(self) -> int: ...
+    def filt(self, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+    def friction_scale(self, model: _ModelArg) -> npt.NDArray[np.float64] | None: ...
+    def base_friction(self, model: _ModelArg) -> npt.NDArray[np.float64]: ...
+    def effect_force(self, model: _ModelArg) -> npt.NDArray[np.float64]: ...
+    def coupling_force(self, model: _ModelArg) -> npt.NDArray[np.float64]: ...
+    def model_force(self, model: _ModelArg) -> npt.NDArray[np.float64]: ...
+    def motor_force(self, model: _ModelArg) -> npt.NDArray[np.float64]: ...
+    def residual(self, model: _ModelArg) -> npt.NDArray[np.float64]: ...
+    def residuals(self, models: list[_ModelArg]) -> npt.NDArray[np.float64]: ...
+    def base_sensitivities(
+        self, model: _ModelArg, names: list[str]
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], list[bool]]: ...
+
+def check_model(model: _ModelArg) -> bool: ...
+def stribeck(v: npt.NDArray[np.float64], model: _ModelArg) -> npt.NDArray[np.float64]: ...
 def friction_force(
     v: npt.NDArray[np.float64],
     dt: npt.NDArray[np.float64],
-    model_json: str,
+    model: _ModelArg,
     z0: float = 0.0,
     return_z: bool = False,
     scale: npt.NDArray[np.float64] | None = None,
@@ -35,7 +74,7 @@ def load_coupling(
     x: npt.NDArray[np.float64],
     v: npt.NDArray[np.float64],
     dt: float,
-    model_json: str,
+    model: _ModelArg,
     scale: npt.NDArray[np.float64] | None = None,
     extra: npt.NDArray[np.float64] | None = None,
     z0: float = 0.0,
@@ -47,7 +86,7 @@ def load_coupling(
     npt.NDArray[np.float64],
 ]: ...
 def simulate(
-    model_json: str,
+    model: _ModelArg,
     t: npt.NDArray[np.float64],
     drive_kind: str,
     drive: npt.NDArray[np.float64],
@@ -58,7 +97,7 @@ def simulate(
     v0: float = 0.0,
 ) -> dict[str, npt.NDArray[np.float64]]: ...
 def simulate_batch(
-    model_jsons: list[str],
+    models: list[_ModelArg],
     t: npt.NDArray[np.float64],
     drive_kind: str,
     drive: npt.NDArray[np.float64],
@@ -88,7 +127,7 @@ def plateaus(
     chunks: int = 1,
 ) -> dict[str, Any]: ...
 def fit_dynamic_record(
-    model_json: str,
+    model: _ModelArg,
     t: npt.NDArray[np.float64],
     x_ref: npt.NDArray[np.float64],
     x: npt.NDArray[np.float64],

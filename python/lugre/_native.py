@@ -32,8 +32,9 @@ def _array(name: str, a: Any) -> np.ndarray:
     return arr
 
 
-def _json(model: ModelLike) -> str:
-    return _as_model(model).to_json(indent=None)
+def _core_model(model: ModelLike) -> Any:
+    """The core's parsed model (``_core.Model``), built once per :class:`Model`."""
+    return _as_model(model)._core_model()
 
 
 def stribeck(v: Any, model: ModelLike) -> np.ndarray:
@@ -60,7 +61,7 @@ def stribeck(v: Any, model: ModelLike) -> np.ndarray:
     >>> float(lugre.stribeck([0.4], lugre.Model.paper())[0])
     161.7
     """
-    return _core.stribeck(_array("v", v), _json(model))
+    return _core.stribeck(_array("v", v), _core_model(model))
 
 
 def friction_force(
@@ -107,7 +108,8 @@ def friction_force(
         dta = np.ascontiguousarray(dt, dtype=np.float64).reshape(-1)
     except (TypeError, ValueError) as e:
         raise InputError.at("dt", f"must be a number or an array of numbers ({e})") from None
-    f, z = _core.friction_force(vv, dta, _json(model), _float("z0", z0), bool(return_z), sc)
+    f, z = _core.friction_force(vv, dta, _core_model(model), _float("z0", z0), bool(return_z),
+                                sc)
     return (f, z) if return_z else f
 
 
@@ -168,7 +170,7 @@ def load_coupling(
     >>> float(np.abs(r.force).max())
     0.0
     """
-    mj = _json(model)
+    mj = _core_model(model)
     xx = _array("x", x)
     vv = _array("v", v)
     sc = None if scale is None else _array("scale", scale)
@@ -233,7 +235,7 @@ def simulate(
         ``t``, ``x``, ``v``, ``z``, ``i``, ``friction`` and ``force`` at ``t``.
     """
     tt, args = _sim_args(t, x_ref, v_ref, current, integrator, substeps, z0, x0, v0)
-    return SimResult(t=tt.copy(), **_core.simulate(_json(model), tt, *args))
+    return SimResult(t=tt.copy(), **_core.simulate(_core_model(model), tt, *args))
 
 
 def _sim_args(t: Any, x_ref: Any, v_ref: Any, current: Any, integrator: Any, substeps: Any,
@@ -275,7 +277,7 @@ def simulate_batch(
         One per model, in order.
     """
     tt, args = _sim_args(t, x_ref, v_ref, current, integrator, substeps, z0, x0, v0)
-    rs = _core.simulate_batch([_json(m) for m in models], tt, *args)
+    rs = _core.simulate_batch([_core_model(m) for m in models], tt, *args)
     return [SimResult(t=tt.copy(), **r) for r in rs]
 
 

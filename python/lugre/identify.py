@@ -377,7 +377,7 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
                             "the dynamic fit simulates the closed loop on the reference")
     def run(mm: Model, s0: float | None, s1: float | None, use_grid: bool) -> dict[str, Any]:
         return _core.fit_dynamic_record(
-            mm.to_json(indent=None), rec.t, rec.x_ref, rec.x, str(weighting), float(c1),
+            mm._core_model(), rec.t, rec.x_ref, rec.x, str(weighting), float(c1),
             float(c2), s0, s1, use_grid, int(max_iter), float(scale_floor), int(substeps),
             str(integrator))
 

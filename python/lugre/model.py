@@ -500,12 +500,14 @@ class Model:
     :meth:`with_friction` and :meth:`replace` return new models.
     """
 
-    __slots__ = ("_data", "_parsed")
+    __slots__ = ("_core", "_data", "_parsed")
 
     def __init__(self, data: Mapping[str, Any] | Model) -> None:
+        self._core: Any = None
         if isinstance(data, Model):
             self._data: dict[str, Any] = _copy.deepcopy(data._data)
             self._parsed: _Parsed = data._parsed
+            self._core = data._core
             return
         if not isinstance(data, Mapping):
             raise ModelError.at(
@@ -616,6 +618,16 @@ class Model:
         str
         """
         return json.dumps(self._data, indent=indent, allow_nan=False)
+
+    def _core_model(self) -> Any:
+        """The model parsed by the compiled core (``lugre._core.Model``), built on first
+        use and kept: a model does not change, so every call of the core takes this one
+        instead of parsing the JSON again."""
+        if self._core is None:
+            from . import _core
+
+            self._core = _core.Model(self.to_json(indent=None))
+        return self._core
 
     def copy(self) -> Model:
         """An independent copy.

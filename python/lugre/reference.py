@@ -13,6 +13,9 @@ step) and meant for checking the core and for reading. Never calls :mod:`lugre._
   Nelder-Mead as the core runs it (``_reference_nm``) and the robust weights
   (``_reference_robust``); their results are the facade's :class:`StaticFit` and
   :class:`DynamicFit`;
+- :func:`evaluate` runs the diagnosis's preparation of the record (SciPy filters) with
+  the residual from :class:`InverseRecord`, the NumPy twin of the inverse-dynamics
+  kernel (``_reference_inverse``);
 - :func:`load_model` and :func:`save_model` are the facade's own (Python) functions.
 
 Examples
@@ -35,6 +38,7 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
+from ._reference_inverse import InverseRecord
 from ._result import CouplingResult, SimResult
 from .exceptions import DataError, InputError, ModelError, ParameterError, _fmt_f64
 from .model import (
@@ -51,13 +55,16 @@ from .model import (
 
 if TYPE_CHECKING:  # pragma: no cover
     from ._reference_dynamic import DynamicFit, fit_dynamic
+    from ._reference_evaluate import evaluate
     from ._reference_static import StaticFit, fit_static
 
 __all__ = [
     "CouplingResult",
     "DynamicFit",
+    "InverseRecord",
     "SimResult",
     "StaticFit",
+    "evaluate",
     "fit_dynamic",
     "fit_static",
     "friction_force",
@@ -77,6 +84,7 @@ _LAZY = {
     "fit_static": "._reference_static",
     "DynamicFit": "._reference_dynamic",
     "fit_dynamic": "._reference_dynamic",
+    "evaluate": "._reference_evaluate",
 }
 
 

@@ -1,7 +1,7 @@
 //! Bindings of the estimators: convert in, run with the interpreter released, convert
 //! the plain-data results into dicts of arrays and numbers.
 
-use super::{interruptible, parse_model, slice, to_py};
+use super::{interruptible, model_of, slice, to_py};
 use crate::error::Error;
 use crate::estimate::{
     fit_dynamic_with, fit_static, plateaus_from_recording, DirectionFit, DynamicFitOptions,
@@ -116,11 +116,11 @@ pub(crate) fn plateaus<'py>(
 
 /// sigma0 and sigma1 from a closed-loop position record; returns a dict.
 #[pyfunction]
-#[pyo3(signature = (model_json, t, x_ref, x, weighting="igg", c1=1.0, c2=0.0, sigma0_start=None, sigma1_start=None, grid=true, max_iter=20, scale_floor=0.0, substeps=1, integrator="exact"))]
+#[pyo3(signature = (model, t, x_ref, x, weighting="igg", c1=1.0, c2=0.0, sigma0_start=None, sigma1_start=None, grid=true, max_iter=20, scale_floor=0.0, substeps=1, integrator="exact"))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fit_dynamic_record<'py>(
     py: Python<'py>,
-    model_json: &str,
+    model: &Bound<'py, PyAny>,
     t: PyReadonlyArray1<'py, f64>,
     x_ref: PyReadonlyArray1<'py, f64>,
     x: PyReadonlyArray1<'py, f64>,
@@ -135,7 +135,7 @@ pub(crate) fn fit_dynamic_record<'py>(
     substeps: usize,
     integrator: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let m = parse_model(py, model_json)?;
+    let m = model_of(py, model)?;
     let r = (|| -> Result<_, Error> {
         let mut opts = DynamicFitOptions {
             weighting: Weighting::from_name(weighting)?,

@@ -5,7 +5,7 @@ use crate::error::{check_finite, Error};
 use crate::friction::{
     friction_force_general_into, friction_force_into, friction_force_varstep_into,
 };
-use crate::servo::{self, CouplingOptions, Drive, Integrator, Model, SimOptions, SimResult};
+use crate::servo::{self, CouplingOptions, Drive, Integrator, SimOptions, SimResult};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
@@ -15,6 +15,9 @@ use std::sync::mpsc::RecvTimeoutError;
 use std::time::Duration;
 
 mod estimate;
+mod inverse;
+
+pub(crate) use inverse::model_of;
 
 /// Map a core error onto the package's exception classes (`lugre.exceptions`).
 pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
@@ -59,10 +62,6 @@ pub(crate) fn slice<'a>(name: &str, a: &'a PyReadonlyArray1<'_, f64>) -> Result<
         .map_err(|_| Error::input(name, "must be a contiguous 1-D float64 array"))
 }
 
-pub(crate) fn parse_model(py: Python<'_>, text: &str) -> PyResult<Model> {
-    Model::from_json(text).map_err(|e| to_py(py, e))
-}
-
 /// Run `work` on a scoped thread with the interpreter released, while this thread
 /// polls for Ctrl-C every 20 ms and sets the cancel flag that `work` watches.
 pub(crate) fn interruptible<T: Send>(
@@ -99,8 +98,8 @@ pub(crate) fn interruptible<T: Send>(
 
 /// Validate a model given as JSON text; returns whether its friction is passive.
 #[pyfunction]
-fn check_model(py: Python<'_>, model_json: &str) -> PyResult<bool> {
-    Ok(parse_model(py, model_json)?.friction.is_passive())
+fn check_model(py: Python<'_>, model: &Bound<'_, PyAny>) -> PyResult<bool> {
+    Ok(model_of(py, model)?.friction.is_passive())
 }
 
 /// Steady-state (Stribeck) friction force for each velocity.
@@ -108,9 +107,9 @@ fn check_model(py: Python<'_>, model_json: &str) -> PyResult<bool> {
 fn stribeck<'py>(
     py: Python<'py>,
     v: PyReadonlyArray1<'py, f64>,
-    model_json: &str,
+    model: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let m = parse_model(py, model_json)?;
+    let m = model_of(py, model)?;
     let v = slice("v", &v).map_err(|e| to_py(py, e))?;
     check_finite("v", v).map_err(|e| to_py(py, e))?;
     let out: Vec<f64> = py.detach(|| v.iter().map(|&x| m.friction.stribeck(x)).collect());
@@ -121,17 +120,17 @@ fn stribeck<'py>(
 ///
 /// The model's `stribeck_shape` applies; `scale` (one per sample) multiplies `g(v)`.
 #[pyfunction]
-#[pyo3(signature = (v, dt, model_json, z0=0.0, return_z=false, scale=None))]
+#[pyo3(signature = (v, dt, model, z0=0.0, return_z=false, scale=None))]
 fn friction_force<'py>(
     py: Python<'py>,
     v: PyReadonlyArray1<'py, f64>,
     dt: PyReadonlyArray1<'py, f64>,
-    model_json: &str,
+    model: &Bound<'py, PyAny>,
     z0: f64,
     return_z: bool,
     scale: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<ArrayPair<'py>> {
-    let m = parse_model(py, model_json)?;
+    let m = model_of(py, model)?;
     let p = m.friction;
     let exponent = m.stribeck_exponent();
     let vs = slice("v", &v).map_err(|e| to_py(py, e))?;
@@ -194,20 +193,20 @@ type ArrayQuad<'py> = (
 /// The load behind the `resonance` coupling driven by the motor motion `x`, `v`;
 /// returns `(force, x_load, v_load, z)` at the samples.
 #[pyfunction]
-#[pyo3(signature = (x, v, dt, model_json, scale=None, extra=None, z0=0.0, substeps=1))]
+#[pyo3(signature = (x, v, dt, model, scale=None, extra=None, z0=0.0, substeps=1))]
 #[allow(clippy::too_many_arguments)]
 fn load_coupling<'py>(
     py: Python<'py>,
     x: PyReadonlyArray1<'py, f64>,
     v: PyReadonlyArray1<'py, f64>,
     dt: f64,
-    model_json: &str,
+    model: &Bound<'py, PyAny>,
     scale: Option<PyReadonlyArray1<'py, f64>>,
     extra: Option<PyReadonlyArray1<'py, f64>>,
     z0: f64,
     substeps: usize,
 ) -> PyResult<ArrayQuad<'py>> {
-    let m = parse_model(py, model_json)?;
+    let m = model_of(py, model)?;
     let r = (|| -> Result<servo::LoadTrajectory, Error> {
         let xs = slice("x", &x)?;
         let vs = slice("v", &v)?;
@@ -286,11 +285,11 @@ fn result_dict<'py>(py: Python<'py>, r: SimResult) -> PyResult<Bound<'py, PyDict
 ///
 /// Runs with the interpreter released and checks for Ctrl-C about every 50 ms.
 #[pyfunction]
-#[pyo3(signature = (model_json, t, drive_kind, drive, integrator="exact", substeps=1, z0=0.0, x0=None, v0=0.0))]
+#[pyo3(signature = (model, t, drive_kind, drive, integrator="exact", substeps=1, z0=0.0, x0=None, v0=0.0))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
-    model_json: &str,
+    model: &Bound<'py, PyAny>,
     t: PyReadonlyArray1<'py, f64>,
     drive_kind: &str,
     drive: PyReadonlyArray1<'py, f64>,
@@ -300,7 +299,7 @@ fn simulate<'py>(
     x0: Option<f64>,
     v0: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let m = parse_model(py, model_json)?;
+    let m = model_of(py, model)?;
     let run = || -> Result<SimResult, Error> {
         let opts = parse_opts(integrator, substeps, z0, x0, v0)?;
         let ts = slice("t", &t)?;
@@ -317,11 +316,11 @@ fn simulate<'py>(
 
 /// Simulate many models on the same input in parallel; returns a list of dicts.
 #[pyfunction]
-#[pyo3(signature = (model_jsons, t, drive_kind, drive, integrator="exact", substeps=1, z0=0.0, x0=None, v0=0.0))]
+#[pyo3(signature = (models, t, drive_kind, drive, integrator="exact", substeps=1, z0=0.0, x0=None, v0=0.0))]
 #[allow(clippy::too_many_arguments)]
 fn simulate_batch<'py>(
     py: Python<'py>,
-    model_jsons: Vec<String>,
+    models: Vec<Bound<'py, PyAny>>,
     t: PyReadonlyArray1<'py, f64>,
     drive_kind: &str,
     drive: PyReadonlyArray1<'py, f64>,
@@ -331,9 +330,9 @@ fn simulate_batch<'py>(
     x0: Option<f64>,
     v0: f64,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    let models = model_jsons
+    let models = models
         .iter()
-        .map(|s| parse_model(py, s))
+        .map(|m| model_of(py, m).map(|m| (*m).clone()))
         .collect::<PyResult<Vec<_>>>()?;
     let results = (|| -> Result<Vec<SimResult>, Error> {
         let opts = parse_opts(integrator, substeps, z0, x0, v0)?;
@@ -358,6 +357,8 @@ fn num_threads() -> usize {
 /// The compiled core of `lugre`.
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<inverse::PyModel>()?;
+    m.add_class::<inverse::PyInverseRecord>()?;
     m.add_function(wrap_pyfunction!(check_model, m)?)?;
     m.add_function(wrap_pyfunction!(stribeck, m)?)?;
     m.add_function(wrap_pyfunction!(friction_force, m)?)?;

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import Model
-from .residual import Signals, base_friction
+from .residual import Signals
 
 __all__ = ["BASE_PARAMS", "LEVELS", "PRESLIDING", "apply_base", "base_jacobian", "get_base",
            "unit"]
@@ -100,6 +100,10 @@ def base_jacobian(model: Model, sig: Signals, fr0: np.ndarray | None = None,
                   ) -> tuple[np.ndarray, list[str], np.ndarray, np.ndarray]:
     """Jacobian of the filtered model force with respect to the base parameters.
 
+    The friction columns are the exact sensitivities of the LuGre force, propagated
+    through the bristle update by the inverse-dynamics kernel
+    (``InverseRecord.base_sensitivities``); the mass column is the acceleration.
+
     Parameters
     ----------
     model : Model
@@ -107,7 +111,7 @@ def base_jacobian(model: Model, sig: Signals, fr0: np.ndarray | None = None,
     sig : Signals
         The prepared recording.
     fr0 : numpy.ndarray, optional
-        ``base_friction(model, sig)`` if already computed.
+        Unused (kept for callers that pass ``base_friction(model, sig)``).
     names : sequence of str, optional
         The parameters to linearise in (default :data:`LEVELS`).
 
@@ -122,36 +126,37 @@ def base_jacobian(model: Model, sig: Signals, fr0: np.ndarray | None = None,
     tol : numpy.ndarray
         Prior standard deviations (absolute).
     """
-    if fr0 is None:
-        fr0 = base_friction(model, sig)
+    del fr0
     wanted = set(LEVELS if names is None else names)
+    fr = model.friction
+    order: list[str] = []
+    for name, _ in BASE_PARAMS:
+        if name not in wanted:
+            continue
+        if name.endswith(".vs"):
+            side = name.split(".")[0]
+            if abs(fr[side]["fs"] - fr[side]["fc"]) < 1e-3 * fr[side]["fc"]:
+                continue  # no Stribeck hump: vs does nothing
+        order.append(name)
+    friction = [n for n in order if n != "mass"]
+    _, jac, nonzero = sig.kernel.base_sensitivities(model, friction)
+    col_of = {n: j for j, n in enumerate(friction)}
     cols: list[np.ndarray] = []
     out: list[str] = []
     theta: list[float] = []
     tol: list[float] = []
-    for name, rel in BASE_PARAMS:
-        if name not in wanted:
-            continue
-        th = get_base(model, name)
+    rel_of = dict(BASE_PARAMS)
+    for name in order:
         if name == "mass":
-            col = sig.a.copy()
-            cols.append(col)
+            cols.append(sig.a.copy())
         else:
-            side, key = (name.split(".") + [""])[:2] if "." in name else ("", name)
-            if key == "vs" and abs(model.friction[side]["fs"] - model.friction[side]["fc"]) < (
-                1e-3 * model.friction[side]["fc"]
-            ):
-                continue  # no Stribeck hump: vs does nothing
-            h = 1e-4 * max(abs(th), 1e-9)
-            if key == "fc":
-                h = -h  # keep fs >= fc
-            m2 = apply_base(model, {name: th + h})
-            col = (base_friction(m2, sig) - fr0) / h
-            if not np.any(np.abs(col) > 0):
+            j = col_of[name]
+            if not nonzero[j]:
                 continue
-            cols.append(sig.filt(col))
+            cols.append(np.asarray(jac[:, j]))
+        th = get_base(model, name)
         out.append(name)
         theta.append(th)
-        tol.append(rel * max(abs(th), 1e-12))
+        tol.append(rel_of[name] * max(abs(th), 1e-12))
     J = np.column_stack(cols) if cols else np.zeros((len(sig), 0))
     return J, out, np.array(theta), np.array(tol)

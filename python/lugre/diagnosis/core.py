@@ -9,7 +9,6 @@ from typing import Any
 
 import numpy as np
 
-from .._native import simulate
 from ..exceptions import InputError
 from ..io import Recording
 from ..model import Model, _as_model
@@ -53,7 +52,8 @@ def _metrics(r: np.ndarray, f: np.ndarray, mask: np.ndarray) -> dict[str, float]
     return {"rms_force": rms, "nrmse_force": rms / rf if rf > 0 else math.nan}
 
 
-def evaluate(recording: Any, model: Any, *, cutoff_hz: float | None = None) -> dict[str, float]:
+def evaluate(recording: Any, model: Any, *, cutoff_hz: float | None = None,
+             backend: str = "core") -> dict[str, float]:
     """Inverse-dynamics force residual of a recording against a model.
 
     ``r = K_F*i - m*a - F_friction - sum(F_effect)`` with every term low-passed by the
@@ -68,6 +68,8 @@ def evaluate(recording: Any, model: Any, *, cutoff_hz: float | None = None) -> d
         The model (its effects included).
     cutoff_hz : float, optional
         Low-pass cut-off (default ``fs/25``).
+    backend : {"core", "reference"}, default "core"
+        The compiled kernel or its NumPy twin.
 
     Returns
     -------
@@ -78,7 +80,7 @@ def evaluate(recording: Any, model: Any, *, cutoff_hz: float | None = None) -> d
     rec = as_recording(recording)
     m = _as_model(model)
     R.check_recording(rec, m)
-    sig = R.prepare(rec, m, cutoff_hz=cutoff_hz)
+    sig = R.prepare(rec, m, cutoff_hz=cutoff_hz, backend=backend)
     R.check_units(sig, m)
     r = R.residual(m, sig)
     out = _metrics(r, sig.fm_f, sig.mask)
@@ -88,7 +90,8 @@ def evaluate(recording: Any, model: Any, *, cutoff_hz: float | None = None) -> d
     return out
 
 
-def _closed_loop(rec: Recording, before: Model, after: Model) -> dict[str, Any] | None:
+def _closed_loop(rec: Recording, before: Model, after: Model,
+                 simulate: Any) -> dict[str, Any] | None:
     c = before.controller
     if c is None or rec.x_ref is None or c.get("type", "pid") != "pid":
         return None
@@ -118,6 +121,7 @@ def diagnose(
     screw_lead: float | None = None,
     free_mass: bool = False,
     tolerance: float = 1.0,
+    backend: str = "core",
 ) -> Diagnosis:
     """Find the physics a model leaves out of a recording.
 
@@ -152,6 +156,9 @@ def diagnose(
         Scale of the base parameters' tolerances (the prior on how far they may move
         from the model): 1 diagnoses a model believed about right; identification from
         a rough start uses a wide one.
+    backend : {"core", "reference"}, default "core"
+        Numerics from the compiled core, or from its NumPy twin ``lugre.reference``
+        (the same diagnosis, slower; for checking).
 
     Returns
     -------
@@ -167,7 +174,7 @@ def diagnose(
     model = _as_model(model)
     # 1. prepare: checks, filtered signals, the residual of the model as given
     R.check_recording(rec, model)
-    sig = R.prepare(rec, model, cutoff_hz=cutoff_hz)
+    sig = R.prepare(rec, model, cutoff_hz=cutoff_hz, backend=backend)
     R.check_units(sig, model)
     r0 = R.residual(model, sig)
     fr0 = R.base_friction(model, sig)
@@ -329,8 +336,8 @@ def diagnose(
                            "after": _metrics(r1, sig.fm_f, sig.mask),
                            "holdout_before": {}, "holdout_after": {}}
     if holdout is not None:
-        hb = evaluate(holdout, model, cutoff_hz=cutoff_hz)
-        ha = evaluate(holdout, aug, cutoff_hz=cutoff_hz)
+        hb = evaluate(holdout, model, cutoff_hz=cutoff_hz, backend=backend)
+        ha = evaluate(holdout, aug, cutoff_hz=cutoff_hz, backend=backend)
         fit["holdout_before"] = {k: hb[k] for k in ("rms_force", "nrmse_force")}
         fit["holdout_after"] = {k: ha[k] for k in ("rms_force", "nrmse_force")}
     fit["held_out_blocks"] = {
@@ -338,7 +345,7 @@ def diagnose(
         "with_findings": float(np.sqrt(ev.sse_b.sum() / n_used)),
     }
     if closed_loop:
-        cl = _closed_loop(rec, model, aug)
+        cl = _closed_loop(rec, model, aug, sig.backend.simulate)
         if cl is not None and "error" not in cl:
             fit["closed_loop"] = cl
 

@@ -411,14 +411,30 @@ class _Secant(Candidate):
     def from_secant(self, h: Any, b: float) -> Any:
         return h
 
-    def columns(self, h: Any, ctx: Context) -> np.ndarray:
+    def _r_base(self, ctx: Context) -> np.ndarray:
         from . import residual as R
 
         key = ("r_base", id(ctx.model))
         if key not in ctx.extra:
             ctx.extra[key] = R.residual(ctx.model, ctx.sig)
-        m1 = ctx.model.replace(effects=list(ctx.model.effects) + [self.effect_at(h)])
-        return (ctx.extra[key] - R.residual(m1, ctx.sig))[:, None]
+        return ctx.extra[key]
+
+    def _with(self, h: Any, ctx: Context) -> Model:
+        return ctx.model.replace(effects=list(ctx.model.effects) + [self.effect_at(h)])
+
+    def columns(self, h: Any, ctx: Context) -> np.ndarray:
+        from . import residual as R
+
+        return (self._r_base(ctx) - R.residual(self._with(h, ctx), ctx.sig))[:, None]
+
+    def columns_many(self, hs: list[Any], ctx: Context) -> list[np.ndarray] | None:
+        """The columns of several grid points at once (the kernel runs them in
+        parallel), or None when this candidate builds its columns otherwise."""
+        if type(self).columns is not _Secant.columns:
+            return None
+        r0 = self._r_base(ctx)
+        rs = ctx.sig.kernel.residuals([self._with(h, ctx) for h in hs])
+        return [(r0 - rs[:, j])[:, None] for j in range(len(hs))]
 
     def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
         return [self.effect_at(self.from_secant(h, float(beta[0])))]

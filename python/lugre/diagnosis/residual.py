@@ -23,17 +23,16 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-from .._native import friction_force, load_coupling
 from ..exceptions import DataError, InputError, UnitsWarning
 from ..io import Recording
 from ..model import Model, _as_model
 
 __all__ = [
     "Signals",
-    "bristles",
+    "base_friction",
     "check_recording",
+    "deadband",
     "lowpass",
-    "lugre_at",
     "model_force",
     "noise_floor",
     "prepare",
@@ -42,6 +41,9 @@ __all__ = [
 
 #: Fewest samples a diagnosis accepts.
 MIN_SAMPLES = 400
+
+#: Odd-extension length of the zero-phase low-pass at each end [samples].
+_PADLEN = 3 * 24
 
 
 def lowpass(y: np.ndarray, cutoff_hz: float, fs: float, order: int = 4) -> np.ndarray:
@@ -66,7 +68,7 @@ def lowpass(y: np.ndarray, cutoff_hz: float, fs: float, order: int = 4) -> np.nd
     if wn >= 0.99:
         return np.array(y, dtype=float, copy=True)
     return signal.sosfiltfilt(_butter(order, wn), y, axis=0, padtype="odd",
-                              padlen=min(3 * 24, len(y) - 1))
+                              padlen=min(_PADLEN, len(y) - 1))
 
 
 @functools.lru_cache(maxsize=16)
@@ -153,6 +155,12 @@ class Signals:
         Measured position.
     force_raw : numpy.ndarray
         Motor force as recorded.
+    kernel : lugre._core.InverseRecord or lugre.reference.InverseRecord
+        The inverse-dynamics kernel over these signals (residual, model force,
+        sensitivities, the parallel low-pass).
+    backend : module
+        ``lugre._native`` or ``lugre.reference``: where the diagnosis takes its other
+        numerics (simulation) from.
     """
 
     t: np.ndarray
@@ -172,10 +180,16 @@ class Signals:
     force_raw: np.ndarray
     recording: Recording | None = None
     info: dict[str, Any] = field(default_factory=dict)
+    kernel: Any = None
+    backend: Any = None
 
     def filt(self, y: np.ndarray) -> np.ndarray:
         """Apply the parallel low-pass to a signal or to the columns of a matrix."""
-        return lowpass(y, self.cutoff_hz, self.fs)
+        y = np.asarray(y, dtype=float)
+        if y.ndim == 1:
+            return self.kernel.filt(y)
+        return np.column_stack([self.kernel.filt(np.ascontiguousarray(c)) for c in y.T]
+                               ) if y.shape[1] else y.copy()
 
     def __len__(self) -> int:
         return int(self.t.size)
@@ -245,6 +259,7 @@ def prepare(
     cutoff_hz: float | None = None,
     drive_cutoff_hz: float | None = None,
     t0: float | None = None,
+    backend: str = "core",
 ) -> Signals:
     """Filter a recording and take its derivatives for inverse dynamics.
 
@@ -260,6 +275,8 @@ def prepare(
         Low-pass of the velocity that drives the bristles; default ``fs/6``.
     t0 : float, optional
         Time origin for time-dependent effects (drift); default the first sample.
+    backend : {"core", "reference"}, default "core"
+        The compiled kernel, or its NumPy twin (same results, for checking).
 
     Returns
     -------
@@ -289,93 +306,34 @@ def prepare(
     mask[:edge] = False
     mask[-edge:] = False
     tt = rec.t - (rec.t[0] if t0 is None else t0)
+    wn = fc / (0.5 * fs)
+    sos = _butter(4, wn) if wn < 0.99 else None
+    if backend == "core":
+        from .. import _core
+        from .. import _native as mod
+
+        kernel_cls: Any = _core.InverseRecord
+    elif backend == "reference":
+        from .. import reference as mod
+
+        kernel_cls = mod.InverseRecord
+    else:
+        raise InputError.at("backend", f"unknown backend {backend!r}: use \"core\" or "
+                            "\"reference\"")
+    x, xd, v, a, fm, fm_f = (np.ascontiguousarray(u, dtype=float) for u in (x, xd, v, a, fm, fm_f))
+    kernel = kernel_cls(np.ascontiguousarray(tt, dtype=float), x, xd, v, a, fm, fm_f, dt, sos,
+                        min(_PADLEN, n - 1))
     return Signals(t=tt, dt=dt, fs=fs, cutoff_hz=fc, x=x, v=v, vf=vf, a=a, fm=fm,
                    fm_f=fm_f, dfm=dfm, spikes=spikes, mask=mask, x_raw=rec.x.copy(),
                    force_raw=force_raw, recording=rec,
-                   info={"drive_cutoff_hz": fd, "quantum": q, "edge": edge, "x_drive": xd})
+                   info={"drive_cutoff_hz": fd, "quantum": q, "edge": edge, "x_drive": xd},
+                   kernel=kernel, backend=mod)
 
 
 # --------------------------------------------------------------------------------------
-# Model force
+# Model force: the inverse-dynamics kernel (``_core.InverseRecord``, or its NumPy twin
+# ``lugre.reference.InverseRecord``) built once per prepared recording
 # --------------------------------------------------------------------------------------
-
-
-def _interp_scale(positions: Any, scale: Any, x: np.ndarray) -> np.ndarray:
-    return np.interp(x, np.asarray(positions, float), np.asarray(scale, float))
-
-
-def friction_scale(model: Model, sig: Signals) -> np.ndarray | None:
-    """The product of the ``position_friction`` and ``drift`` scales, or ``None``."""
-    s = None
-    for e in model.effects:
-        k = e["effect"]
-        if k == "position_friction":
-            f = _interp_scale(e["positions"], e["scale"], sig.x)
-        elif k == "drift":
-            f = 1.0 - e["gain"] * (1.0 - np.exp(-sig.t / e["time_constant"]))
-        else:
-            continue
-        s = f if s is None else s * f
-    return s
-
-
-def _g(model: Model, v: np.ndarray, scale: np.ndarray | None, exponent: float) -> np.ndarray:
-    f = model.friction
-    pos, neg = f["positive"], f["negative"]
-    vp = np.maximum(v, 0.0)
-    vn = np.minimum(v, 0.0)
-    gp = pos["fc"] + (pos["fs"] - pos["fc"]) * np.exp(-np.abs(vp / pos["vs"]) ** exponent)
-    gn = neg["fc"] + (neg["fs"] - neg["fc"]) * np.exp(-np.abs(vn / neg["vs"]) ** exponent)
-    g = np.where(v >= 0, gp, gn)
-    return g if scale is None else g * scale
-
-
-def bristles(v: np.ndarray, dt: float, model: Model, scale: np.ndarray | None,
-             exponent: float = 2.0) -> np.ndarray:
-    """Bristle state ``z[k]`` at the sample instants, advanced exactly over each sample
-    interval with ``v`` held (``scale`` multiplies ``g`` per sample, ``exponent`` is the
-    Stribeck exponent).
-
-    Parameters
-    ----------
-    v : numpy.ndarray
-        Velocity held over each interval ``[t_k, t_k+1)`` [m/s].
-    dt : float
-        Sample interval [s].
-    model : Model
-        Friction parameters.
-    scale : numpy.ndarray or None
-        Scale of the Coulomb and static levels, one per sample (None: 1).
-    exponent : float, default 2.0
-        Stribeck exponent (``stribeck_shape``).
-
-    Returns
-    -------
-    numpy.ndarray
-        ``z[k]``, the state at ``t_k`` [m].
-    """
-    shape = [] if exponent == 2.0 else [{"effect": "stribeck_shape", "exponent": exponent}]
-    fm = model.replace(effects=shape) if model.effects != shape else model
-    return friction_force(v, dt, fm, return_z=True, scale=scale)[1]
-
-
-def lugre_at(model: Model, v: np.ndarray, z: np.ndarray, scale: np.ndarray | None,
-             exponent: float = 2.0) -> np.ndarray:
-    """LuGre force at states ``z`` and velocities ``v``:
-    ``sigma0*z + sigma1*(v - sigma0*|v|*z/g(v)) + sigma2*v``."""
-    f = model.friction
-    s0, s1 = float(f["sigma0"]), float(f["sigma1"])
-    g = _g(model, v, scale, exponent)
-    s2 = np.where(v >= 0, f["positive"]["sigma2"], f["negative"]["sigma2"])
-    return s0 * z + s1 * (v - s0 * np.abs(v) * z / g) + s2 * v
-
-
-def stribeck_exponent(model: Model) -> float:
-    """The model's Stribeck exponent (``stribeck_shape``; 2 without it)."""
-    for e in model.effects:
-        if e["effect"] == "stribeck_shape":
-            return float(e["exponent"])
-    return 2.0
 
 
 def base_friction(model: Model, sig: Signals) -> np.ndarray:
@@ -387,94 +345,12 @@ def base_friction(model: Model, sig: Signals) -> np.ndarray:
     with ``v[k-1]`` held it would trail the samples by half an interval, a force error
     of ``sigma0*v*dt/2`` in presliding that reads as extra damping.
     """
-    s = friction_scale(model, sig)
-    n = stribeck_exponent(model)
-    v = sig.v
-    vh = np.empty_like(v)
-    vh[:-1] = 0.5 * (v[:-1] + v[1:])
-    vh[-1] = v[-1]
-    sh = None
-    if s is not None:
-        sh = np.empty_like(s)
-        sh[:-1] = 0.5 * (s[:-1] + s[1:])
-        sh[-1] = s[-1]
-    z = bristles(vh, sig.dt, model, sh, n)
-    return lugre_at(model, v, z, s, n)
-
-
-def lag_foh(f: np.ndarray, bandwidth_hz: float, dt: float) -> np.ndarray:
-    """First-order lag of a signal interpolated linearly between its samples (exact).
-
-    ``y[n] = c*y[n-1] + (1 - c)*f[n-1] + (1 - (1 - c)/a)*(f[n] - f[n-1])`` with
-    ``a = 2*pi*bandwidth*dt`` and ``c = exp(-a)``: the continuous lag of the
-    piecewise-linear signal, whose mean delay is ``1/(2*pi*bandwidth)`` whatever the
-    sample interval (the plain discrete lag ``c/(1-c)`` samples understates it).
-    """
-    a = 2.0 * math.pi * bandwidth_hz * dt
-    c = math.exp(-a)
-    b1 = 1.0 - (1.0 - c) / a
-    # y[n] = c*y[n-1] + b1*f[n] + (1 - c - b1)*f[n-1]
-    return signal.lfilter([b1, 1.0 - c - b1], [1.0, -c], f, zi=[(1.0 - b1) * f[0]])[0]
+    return sig.kernel.base_friction(model)
 
 
 def deadband(f: np.ndarray, band: float) -> np.ndarray:
     """``sign(f)*max(|f| - band, 0)`` (a dead-band in force units)."""
     return np.sign(f) * np.maximum(np.abs(f) - band, 0.0)
-
-
-def motor_force_effective(model: Model, sig: Signals) -> np.ndarray:
-    """The filtered motor force after the ``delay``, ``deadband`` and ``current_lag``
-    effects (in this order: the dead-band acts on the delayed command, the lag on the
-    force it gives)."""
-    f = sig.fm
-    eff = {e["effect"]: e for e in model.effects}
-    changed = False
-    if "delay" in eff and eff["delay"]["seconds"] > 0:
-        f = np.interp(sig.t - eff["delay"]["seconds"], sig.t, f)
-        changed = True
-    if "deadband" in eff and eff["deadband"]["current"] > 0:
-        f = deadband(f, eff["deadband"]["current"] * model.force_constant)
-        changed = True
-    if "current_lag" in eff:
-        f = lag_foh(f, eff["current_lag"]["bandwidth"], sig.dt)
-        changed = True
-    return sig.filt(f) if changed else sig.fm_f
-
-
-def effect_force(model: Model, sig: Signals) -> np.ndarray:
-    """Unfiltered sum of the effect forces (cogging, spring, offset, drag)."""
-    out = np.zeros(len(sig))
-    x = sig.x
-    for e in model.effects:
-        k = e["effect"]
-        if k == "cogging":
-            w = 2.0 * math.pi / e["pitch"]
-            out += e["amplitude"] * np.sin(w * x + e.get("phase", 0.0))
-            for j, (amp, ph) in enumerate(e.get("harmonics", []) or []):
-                out += amp * np.sin((j + 2) * w * x + ph)
-        elif k == "spring":
-            out += e["stiffness"] * (x - e.get("x0", 0.0))
-        elif k == "offset":
-            out += e["force"]
-        elif k == "drag":
-            out += e["coefficient"] * np.abs(sig.v) * sig.v
-    return out
-
-
-def coupling_force(model: Model, sig: Signals) -> np.ndarray:
-    """Unfiltered force the compliant coupling of the model's ``resonance`` passes to the
-    load, the load simulated along the filtered motor motion with its friction (and the
-    friction scales) and the effect forces on it (``lugre.load_coupling``)."""
-    # the motion that drives the bristles of the rigid model, and substeps so that the
-    # load's bristles trail the samples by 1/8 of an interval, not by half of one
-    return load_coupling(sig.info["x_drive"], sig.v, sig.dt, model,
-                         scale=friction_scale(model, sig), extra=effect_force(model, sig),
-                         substeps=4).force
-
-
-def total_mass(model: Model) -> float:
-    """Axis mass plus every ``mass`` effect."""
-    return model.mass + sum(e["delta"] for e in model.effects if e["effect"] == "mass")
 
 
 def model_force(model: Model, sig: Signals) -> np.ndarray:
@@ -483,20 +359,15 @@ def model_force(model: Model, sig: Signals) -> np.ndarray:
     With a ``resonance`` the encoder sees the motor, ``(1 - r)*m``, and the load ``r*m``
     carries the friction and the effect forces behind a spring-damper: the motor gives
     ``(1 - r)*m*a + F_s``, ``F_s`` the force the coupling passes to the load, simulated
-    along the measured motor motion (:func:`coupling_force`).
+    along the measured motor motion (``lugre.load_coupling``, four substeps per sample).
     """
-    m = total_mass(model)
-    res = next((e for e in model.effects if e["effect"] == "resonance"), None)
-    if res is None:
-        fr = base_friction(model, sig) + effect_force(model, sig)
-        return m * sig.a + sig.filt(fr)
-    r = float(res["load_fraction"])
-    return (1.0 - r) * m * sig.a + sig.filt(coupling_force(model, sig))
+    return sig.kernel.model_force(model)
 
 
 def residual(model: Model, sig: Signals) -> np.ndarray:
-    """Force residual ``filt(F_m) - m*a - filt(F_friction + F_effects)`` [N]."""
-    return motor_force_effective(model, sig) - model_force(model, sig)
+    """Force residual ``filt(F_m') - m*a - filt(F_friction + F_effects)`` [N], ``F_m'``
+    the motor force after the model's ``delay``, ``deadband`` and ``current_lag``."""
+    return sig.kernel.residual(model)
 
 
 # --------------------------------------------------------------------------------------

@@ -52,17 +52,33 @@ class Term:
 
 @dataclass
 class Evaluation:
-    """Scores of one candidate model."""
+    """Scores of one candidate model (``fitted`` and ``resid`` computed when asked:
+    the search scores hundreds of fits and looks at the residual of a few)."""
 
     score: float
     sse_b: np.ndarray
     prior: float
     beta: np.ndarray
-    fitted: np.ndarray
-    resid: np.ndarray
     sse: float
     splits: list[slice] = field(default_factory=list)
     jack: np.ndarray | None = None
+    r: np.ndarray | None = None
+    J: np.ndarray | None = None
+    X: np.ndarray | None = None
+
+    @property
+    def fitted(self) -> np.ndarray:
+        """The fitted change of the residual, ``J @ beta_base + X @ beta_effects`` [N]."""
+        assert self.J is not None and self.X is not None
+        q = self.J.shape[1]
+        out = self.J @ self.beta[:q]
+        return out + self.X @ self.beta[q:] if self.X.shape[1] else out
+
+    @property
+    def resid(self) -> np.ndarray:
+        """The residual left by the fit [N]."""
+        assert self.r is not None
+        return self.r - self.fitted
 
 
 class Scorer:
@@ -188,10 +204,9 @@ class Scorer:
             sse_b[k] = rr_b[k] - 2 * bk @ h_b[k] + bk @ G_b[k] @ bk
             jack[k] = bk / sc
         beta = b / sc
-        fitted = self.J @ beta[:q] + (X @ beta[q:] if p else 0.0)
         score = float(sse_b.sum() / self.s2 + prior)
-        return Evaluation(score=score, sse_b=sse_b, prior=prior, beta=beta, fitted=fitted,
-                          resid=self.r - fitted, sse=sse, splits=self.blocks, jack=jack)
+        return Evaluation(score=score, sse_b=sse_b, prior=prior, beta=beta, sse=sse,
+                          splits=self.blocks, jack=jack, r=self.r, J=self.J, X=X)
 
 
 def make_term(c: Candidate, h: Any, ctx: Context) -> Term:
@@ -201,12 +216,39 @@ def make_term(c: Candidate, h: Any, ctx: Context) -> Term:
     so they are kept on the context: the forward selection profiles the same grids at
     every step.
     """
-    key = ("columns", c.effect, h if isinstance(h, (tuple, str)) or h is None else float(h))
     cache = ctx.extra.setdefault(("cache", id(ctx.model)), {})
+    key = _column_key(c, h)
     X = cache.get(key)
     if X is None:
         X = cache[key] = c.columns(h, ctx)
     return Term(cand=c, h=h, X=X, prior=c.prior_tol(h, ctx), center=c.prior_center(h, ctx))
+
+
+def _column_key(c: Candidate, h: Any) -> tuple[Any, ...]:
+    return ("columns", c.effect, h if isinstance(h, (tuple, str)) or h is None else float(h))
+
+
+#: Most column bytes built in one parallel batch.
+_BATCH_BYTES = 64 * 2**20
+
+
+def prefetch(c: Candidate, hs: Any, ctx: Context) -> None:
+    """Build the missing columns of grid points ``hs`` in parallel batches, when the
+    candidate can (``columns_many``), into the cache :func:`make_term` reads."""
+    many = getattr(c, "columns_many", None)
+    if many is None:
+        return
+    cache = ctx.extra.setdefault(("cache", id(ctx.model)), {})
+    todo = [h if isinstance(h, tuple) else float(h) for h in hs]
+    todo = [h for h in todo if _column_key(c, h) not in cache]
+    per = max(1, _BATCH_BYTES // (8 * max(len(ctx.sig), 1)))
+    for i in range(0, len(todo), per):
+        chunk = todo[i:i + per]
+        cols = many(chunk, ctx)
+        if cols is None:
+            return
+        for h, X in zip(chunk, cols):
+            cache[_column_key(c, h)] = X
 
 
 def _profile(scorer: Scorer, kept: list[Term], c: Candidate, grid: np.ndarray, ctx: Context
@@ -220,6 +262,7 @@ def _profile(scorer: Scorer, kept: list[Term], c: Candidate, grid: np.ndarray, c
     start = q + sum(t.X.shape[1] for t in kept)
 
     def run(hs: Any) -> list[tuple[Any, float, np.ndarray, Term, Evaluation]]:
+        prefetch(c, hs, ctx)
         out = []
         for h in hs:
             h = h if isinstance(h, tuple) else float(h)

@@ -1,0 +1,422 @@
+"""NumPy twin of the inverse-dynamics kernel (``src/inverse``): :class:`InverseRecord`.
+
+The same steps as the core, in the same order (``docs/DESIGN.md``, "Inverse
+dynamics"): the zero-phase low-pass by second-order sections with odd extension, the
+friction scales, the bristles advanced with the mid-interval velocity, the effect forces,
+the load behind a ``resonance``, the motor force after delay, dead-band and current lag,
+and the exact sensitivities of the LuGre force to its parameters. Exported as
+``lugre.reference.InverseRecord``; the diagnosis runs on either.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from .exceptions import InputError, ParameterError
+from .model import ModelLike, _as_model
+
+__all__ = ["COUPLING_SUBSTEPS", "InverseRecord", "parse_base_param"]
+
+#: Substeps multiplier of the load simulation behind a ``resonance``.
+COUPLING_SUBSTEPS = 4
+
+_SIDES = ("positive", "negative")
+_KEYS = ("fc", "fs", "sigma2", "vs")
+
+
+def parse_base_param(name: str) -> tuple[str, str]:
+    """``(side, key)`` of a friction parameter path (side ``""`` for sigma0/sigma1)."""
+    if name in ("sigma0", "sigma1"):
+        return "", name
+    side, _, key = name.partition(".")
+    if side not in _SIDES or key not in _KEYS:
+        raise InputError.at(
+            "names",
+            f"unknown friction parameter {name!r}: use sigma0, sigma1 or "
+            "positive/negative.fc, .fs, .sigma2, .vs",
+        )
+    return side, key
+
+
+def _vec(name: str, a: Any) -> np.ndarray:
+    try:
+        arr = np.array(a, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise InputError.at(name, f"must be an array of numbers ({e})") from None
+    if arr.ndim != 1:
+        raise InputError.at(name, "must be a contiguous 1-D float64 array")
+    return arr
+
+
+def _interp(x: np.ndarray, xp: Any, fp: Any) -> np.ndarray:
+    """``numpy.interp`` written out as the core does it (knots exact)."""
+    xp = [float(u) for u in xp]
+    fp = [float(u) for u in fp]
+    m = len(xp)
+    out = np.empty(x.size)
+    for k, xv in enumerate(x.tolist()):
+        if xv < xp[0]:
+            out[k] = fp[0]
+        elif xv >= xp[m - 1]:
+            out[k] = fp[m - 1]
+        else:
+            j = 0
+            lo, hi = 0, m
+            while lo < hi:  # partition point of xp <= xv
+                mid = (lo + hi) // 2
+                if xp[mid] <= xv:
+                    lo = mid + 1
+                else:
+                    hi = mid
+            j = lo - 1
+            if xp[j] == xv:
+                out[k] = fp[j]
+            else:
+                slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j])
+                out[k] = slope * (xv - xp[j]) + fp[j]
+    return out
+
+
+def _midpoints(a: np.ndarray) -> np.ndarray:
+    h = np.empty_like(a)
+    h[:-1] = 0.5 * (a[:-1] + a[1:])
+    h[-1] = a[-1]
+    return h
+
+
+class _Lowpass:
+    """Second-order sections forward and backward, odd extension (SciPy's
+    ``sosfiltfilt(padtype="odd")``)."""
+
+    def __init__(self, sos: Any, padlen: int) -> None:
+        self.sections: list[tuple[float, ...]] = []
+        self.zi: list[tuple[float, float]] = []
+        self.padlen = int(padlen)
+        if sos is None:
+            return
+        s = np.asarray(sos, dtype=float)
+        if s.ndim != 2 or s.shape[1] != 6:
+            raise InputError.at("sos", f"has {s.shape[-1] if s.ndim else 0} columns: give one "
+                                "row [b0, b1, b2, 1, a1, a2] per section")
+        scale = 1.0
+        for k, row in enumerate(s.tolist()):
+            if not all(math.isfinite(c) for c in row):
+                raise InputError.at("sos", f"section {k} has a non-finite coefficient")
+            if row[3] != 1.0:
+                raise InputError.at("sos", f"section {k} has a0 = {row[3]}: normalise the "
+                                    "sections to a0 = 1")
+            b0, b1, b2, _, a1, a2 = row
+            den = 1.0 + a1 + a2
+            if den == 0.0:
+                raise InputError.at("sos", f"section {k} has a pole at z = 1: it is not a "
+                                    "low-pass")
+            c0, c1 = b1 - a1 * b0, b2 - a2 * b0
+            z0 = (c0 + c1) / den
+            z1 = c1 - a2 * z0
+            self.zi.append((scale * z0, scale * z1))
+            self.sections.append(tuple(row))
+            scale *= (b0 + b1 + b2) / den
+
+    def _run(self, y: list[float], x0: float) -> None:
+        st = [[z0 * x0, z1 * x0] for z0, z1 in self.zi]
+        secs = list(zip(self.sections, st))
+        for k in range(len(y)):
+            x = y[k]
+            for c, s in secs:
+                out = c[0] * x + s[0]
+                s[0] = c[1] * x - c[4] * out + s[1]
+                s[1] = c[2] * x - c[5] * out
+                x = out
+            y[k] = x
+
+    def filtfilt(self, y: np.ndarray) -> np.ndarray:
+        n = y.size
+        if not self.sections or n == 0:
+            return np.array(y, dtype=float)
+        edge = min(self.padlen, n - 1)
+        yl = y.tolist()
+        first, last = yl[0], yl[-1]
+        ext = ([2.0 * first - yl[k] for k in range(edge, 0, -1)] + yl
+               + [2.0 * last - yl[n - 1 - k] for k in range(1, edge + 1)])
+        self._run(ext, ext[0])
+        ext.reverse()
+        self._run(ext, ext[0])
+        ext.reverse()
+        return np.array(ext[edge:edge + n])
+
+
+class InverseRecord:
+    """A recording prepared for inverse dynamics (NumPy twin of ``_core.InverseRecord``).
+
+    Parameters
+    ----------
+    t, x, x_drive, v, a, fm, fm_f : array_like
+        Time from the origin of time-dependent effects [s], low-passed position [m],
+        lightly filtered position and the velocity that drives the bristles, the
+        acceleration of ``x``, the motor force [N] and its low-passed copy.
+    dt : float
+        Sample interval [s].
+    sos : array_like, optional
+        Sections ``[b0, b1, b2, 1, a1, a2]`` of the parallel low-pass (None: no filter).
+    padlen : int, default 0
+        Odd-extension length at each end (capped at ``len - 1``).
+    """
+
+    def __init__(self, t: Any, x: Any, x_drive: Any, v: Any, a: Any, fm: Any, fm_f: Any,
+                 dt: float, sos: Any = None, padlen: int = 0) -> None:
+        self._filter = _Lowpass(sos, padlen)
+        arrays = {"t": t, "x": x, "x_drive": x_drive, "v": v, "a": a, "fm": fm, "fm_f": fm_f}
+        vals = {k: _vec(k, a_) for k, a_ in arrays.items()}
+        n = vals["t"].size
+        if n < 2:
+            raise InputError.at("t", "needs at least two samples")
+        for k, arr in vals.items():
+            if arr.size != n:
+                raise InputError.at(k, f"has {arr.size} samples but t has {n}: give arrays "
+                                    "of the same length")
+            bad = np.flatnonzero(~np.isfinite(arr))
+            if bad.size:
+                raise InputError.at(k, f"element {bad[0]} is {arr[bad[0]]} : remove or "
+                                    "interpolate non-finite samples")
+        dt = float(dt)
+        if not (math.isfinite(dt) and dt > 0.0):
+            raise ParameterError.invalid("dt", dt, "must be a finite sample interval "
+                                         "greater than zero [s]")
+        self.dt = dt
+        self.t, self.x, self.x_drive = vals["t"], vals["x"], vals["x_drive"]
+        self.v, self.a, self.fm, self.fm_f = vals["v"], vals["a"], vals["fm"], vals["fm_f"]
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    def filt(self, y: Any) -> np.ndarray:
+        """The parallel low-pass of a signal of the record's length."""
+        ys = _vec("y", y)
+        if ys.size != len(self):
+            raise InputError.at("y", f"has {ys.size} samples but the record has {len(self)}: "
+                                "give arrays of the same length")
+        return self._filter.filtfilt(ys)
+
+    def friction_scale(self, model: ModelLike) -> np.ndarray | None:
+        """Product of the ``position_friction`` and ``drift`` scales, or None."""
+        m = _as_model(model)
+        s = None
+        for e in m.effects:
+            k = e["effect"]
+            if k == "position_friction":
+                f = _interp(self.x, e["positions"], e["scale"])
+            elif k == "drift":
+                f = 1.0 - e["gain"] * (1.0 - np.exp(-self.t / e["time_constant"]))
+            else:
+                continue
+            s = f.copy() if s is None else s * f
+        return s
+
+    @staticmethod
+    def _exponent(m: Any) -> float | None:
+        for e in m.effects:
+            if e["effect"] == "stribeck_shape":
+                ex = float(e["exponent"])
+                return None if ex == 2.0 else ex
+        return None
+
+    @staticmethod
+    def _g(fr: dict[str, Any], v: float, exponent: float | None) -> float:
+        s = fr["positive"] if v >= 0.0 else fr["negative"]
+        r = v / s["vs"]
+        if exponent is None:
+            return s["fc"] + (s["fs"] - s["fc"]) * math.exp(-(r * r))
+        return s["fc"] + (s["fs"] - s["fc"]) * math.exp(-(abs(r) ** exponent))
+
+    def _bristles(self, m: Any, exponent: float | None) -> tuple[list[float], Any]:
+        s = self.friction_scale(m)
+        vh = _midpoints(self.v).tolist()
+        sh = None if s is None else _midpoints(s).tolist()
+        fr = m.friction
+        s0 = float(fr["sigma0"])
+        dt = self.dt
+        z = 0.0
+        zs = []
+        for k, u in enumerate(vh):
+            zs.append(z)
+            if u == 0.0:
+                continue
+            g = (1.0 if sh is None else sh[k]) * self._g(fr, u, exponent)
+            sign = 1.0 if u > 0.0 else -1.0
+            zss = sign * g / s0
+            z = zss + (z - zss) * math.exp(-(s0 * abs(u) * dt / g))
+        return zs, s
+
+    def base_friction(self, model: ModelLike) -> np.ndarray:
+        """Unfiltered LuGre force at the samples."""
+        m = _as_model(model)
+        ex = self._exponent(m)
+        z, s = self._bristles(m, ex)
+        fr = m.friction
+        s0, s1 = float(fr["sigma0"]), float(fr["sigma1"])
+        out = np.empty(len(self))
+        for k, v in enumerate(self.v.tolist()):
+            g = (1.0 if s is None else float(s[k])) * self._g(fr, v, ex)
+            s2 = fr["positive"]["sigma2"] if v >= 0.0 else fr["negative"]["sigma2"]
+            zdot = v - s0 * abs(v) * z[k] / g
+            out[k] = s0 * z[k] + s1 * zdot + s2 * v
+        return out
+
+    def effect_force(self, model: ModelLike) -> np.ndarray:
+        """Unfiltered sum of the effect forces (cogging, spring, offset, drag)."""
+        m = _as_model(model)
+        out = np.zeros(len(self))
+        x, v = self.x, self.v
+        for e in m.effects:
+            k = e["effect"]
+            if k == "cogging":
+                w = 2.0 * math.pi / e["pitch"]
+                out += e["amplitude"] * np.sin(w * x + e.get("phase", 0.0))
+                for j, (amp, ph) in enumerate(e.get("harmonics", []) or []):
+                    out += amp * np.sin(float(j + 2) * w * x + ph)
+            elif k == "spring":
+                out += e["stiffness"] * (x - e.get("x0", 0.0))
+            elif k == "offset":
+                out += e["force"]
+            elif k == "drag":
+                out += e["coefficient"] * np.abs(v) * v
+        return out
+
+    def coupling_force(self, model: ModelLike) -> np.ndarray:
+        """Unfiltered force the ``resonance`` coupling passes to the load."""
+        from .reference import load_coupling
+
+        m = _as_model(model)
+        return load_coupling(self.x_drive, self.v, self.dt, m, scale=self.friction_scale(m),
+                             extra=self.effect_force(m), substeps=COUPLING_SUBSTEPS).force
+
+    def model_force(self, model: ModelLike) -> np.ndarray:
+        """Filtered force the model needs besides the motor."""
+        m = _as_model(model)
+        mass = m.total_mass
+        res = next((e for e in m.effects if e["effect"] == "resonance"), None)
+        if res is None:
+            f = self.base_friction(m) + self.effect_force(m)
+            return mass * self.a + self.filt(f)
+        r = float(res["load_fraction"])
+        return (1.0 - r) * mass * self.a + self.filt(self.coupling_force(m))
+
+    def motor_force(self, model: ModelLike) -> np.ndarray:
+        """Filtered motor force after the ``delay``, ``deadband`` and ``current_lag``."""
+        m = _as_model(model)
+        delay = band = lag = None
+        for e in m.effects:
+            k = e["effect"]
+            if k == "delay" and e["seconds"] > 0:
+                delay = float(e["seconds"])
+            elif k == "deadband" and e["current"] > 0:
+                band = float(e["current"]) * m.force_constant
+            elif k == "current_lag":
+                lag = float(e["bandwidth"])
+        if delay is None and band is None and lag is None:
+            return self.fm_f.copy()
+        f = self.fm.copy()
+        if delay is not None:
+            f = _interp(self.t - delay, self.t, self.fm)
+        if band is not None:
+            f = np.sign(f) * np.maximum(np.abs(f) - band, 0.0)
+        if lag is not None:
+            a = 2.0 * math.pi * lag * self.dt
+            c = math.exp(-a)
+            b1 = 1.0 - (1.0 - c) / a
+            b2 = 1.0 - c - b1
+            y = f.tolist()
+            state = (1.0 - b1) * y[0]
+            for k, x in enumerate(y):
+                out = b1 * x + state
+                state = b2 * x + c * out
+                y[k] = out
+            f = np.array(y)
+        return self.filt(f)
+
+    def residual(self, model: ModelLike) -> np.ndarray:
+        """Force residual ``filt(F_m') - m*a - filt(F_friction + F_effects)`` [N]."""
+        m = _as_model(model)
+        return self.motor_force(m) - self.model_force(m)
+
+    def residuals(self, models: list[ModelLike]) -> np.ndarray:
+        """Residuals of several models, one column each."""
+        if not models:
+            return np.zeros((len(self), 0))
+        return np.column_stack([self.residual(m) for m in models])
+
+    def base_sensitivities(self, model: ModelLike, names: list[str]
+                           ) -> tuple[np.ndarray, np.ndarray, list[bool]]:
+        """``(force, J, nonzero)``: the LuGre force, its filtered derivatives with respect
+        to the named parameters, and whether each unfiltered column is non-zero."""
+        m = _as_model(model)
+        params = [parse_base_param(n) for n in names]
+        ex = self._exponent(m)
+        exn = 2.0 if ex is None else ex
+        fr = m.friction
+        s0, s1 = float(fr["sigma0"]), float(fr["sigma1"])
+        s = self.friction_scale(m)
+        sl = None if s is None else s.tolist()
+        sh = None if s is None else _midpoints(s).tolist()
+        vl = self.v.tolist()
+        vh = _midpoints(self.v).tolist()
+        n, q = len(vl), len(params)
+        force = np.empty(n)
+        cols = np.zeros((n, q))
+        dz = [0.0] * q
+        z = 0.0
+        dt = self.dt
+
+        def dg(side: str, key: str, v: float) -> tuple[float, float]:
+            own = "positive" if v >= 0.0 else "negative"
+            if side != own:
+                return 0.0, 0.0
+            st = fr[own]
+            r = abs(v / st["vs"])
+            p = r * r if exn == 2.0 else r ** exn
+            e = math.exp(-p)
+            if key == "fc":
+                return 1.0 - e, 0.0
+            if key == "fs":
+                return e, 0.0
+            if key == "vs":
+                return (st["fs"] - st["fc"]) * e * exn * p / st["vs"], 0.0
+            return 0.0, 1.0  # sigma2
+
+        for k in range(n):
+            v = vl[k]
+            sc = 1.0 if sl is None else sl[k]
+            g = sc * self._g(fr, v, ex)
+            s2 = fr["positive"]["sigma2"] if v >= 0.0 else fr["negative"]["sigma2"]
+            w = v - s0 * abs(v) * z / g
+            force[k] = s0 * z + s1 * w + s2 * v
+            for j, (side, key) in enumerate(params):
+                dg0, ds2 = dg(side, key, v) if side else (0.0, 0.0)
+                dgk = sc * dg0
+                ds0 = 1.0 if key == "sigma0" else 0.0
+                ds1 = 1.0 if key == "sigma1" else 0.0
+                dw = -abs(v) * (ds0 * z / g + s0 * dz[j] / g - s0 * z * dgk / (g * g))
+                cols[k, j] = ds0 * z + s0 * dz[j] + ds1 * w + s1 * dw + ds2 * v
+            if k + 1 == n:
+                break
+            u = vh[k]
+            if u == 0.0:
+                continue
+            su = 1.0 if sh is None else sh[k]
+            gh = su * self._g(fr, u, ex)
+            sign = 1.0 if u > 0.0 else -1.0
+            zss = sign * gh / s0
+            e = math.exp(-(s0 * abs(u) * dt / gh))
+            for j, (side, key) in enumerate(params):
+                dgh = su * (dg(side, key, u)[0] if side else 0.0)
+                ds0 = 1.0 if key == "sigma0" else 0.0
+                dzss = sign * (dgh / s0 - gh * ds0 / (s0 * s0))
+                da = abs(u) * dt * (ds0 / gh - s0 * dgh / (gh * gh))
+                dz[j] = dzss * (1.0 - e) + e * dz[j] - (z - zss) * e * da
+            z = zss + (z - zss) * e
+        nonzero = [bool(np.any(cols[:, j] != 0.0)) for j in range(q)]
+        jac = np.column_stack([self.filt(cols[:, j]) for j in range(q)]) if q else np.zeros((n, 0))
+        return force, jac, nonzero

@@ -1,0 +1,182 @@
+//! Zero-phase low-pass by second-order sections run forward and backward.
+//!
+//! [`Lowpass::filtfilt`] follows SciPy's `sosfiltfilt(sos, y, padtype="odd",
+//! padlen=padlen)` step for step: odd extension of `padlen` samples at both ends, each
+//! section started in the steady state of the first (then last) extended sample
+//! (`sosfilt_zi`), the sections run in direct form II transposed, forward then backward,
+//! and the extension cut off. The coefficients come from the caller (a Butterworth
+//! design, `scipy.signal.butter(..., output="sos")` in the Python package).
+
+use crate::error::{Error, Result};
+
+/// A cascade of second-order sections `[b0, b1, b2, 1, a1, a2]` run forward and
+/// backward; no sections is the identity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lowpass {
+    sections: Vec<[f64; 6]>,
+    zi: Vec<[f64; 2]>,
+    padlen: usize,
+}
+
+impl Lowpass {
+    /// The identity (no filtering).
+    pub fn identity() -> Lowpass {
+        Lowpass {
+            sections: Vec::new(),
+            zi: Vec::new(),
+            padlen: 0,
+        }
+    }
+
+    /// A filter from its sections (`a0` must be 1) and the odd-extension length
+    /// (capped at `len - 1` of each signal, as SciPy does).
+    pub fn new(sections: Vec<[f64; 6]>, padlen: usize) -> Result<Lowpass> {
+        let mut zi = Vec::with_capacity(sections.len());
+        let mut scale = 1.0;
+        for (k, s) in sections.iter().enumerate() {
+            if s.iter().any(|c| !c.is_finite()) {
+                return Err(Error::input(
+                    "sos",
+                    format!("section {k} has a non-finite coefficient"),
+                ));
+            }
+            if s[3] != 1.0 {
+                return Err(Error::input(
+                    "sos",
+                    format!(
+                        "section {k} has a0 = {}: normalise the sections to a0 = 1",
+                        s[3]
+                    ),
+                ));
+            }
+            let (b0, b1, b2, a1, a2) = (s[0], s[1], s[2], s[4], s[5]);
+            let den = 1.0 + a1 + a2;
+            if den == 0.0 {
+                return Err(Error::input(
+                    "sos",
+                    format!("section {k} has a pole at z = 1: it is not a low-pass"),
+                ));
+            }
+            // steady state of the transposed direct form II for a unit input:
+            // (1 + a1) z0 - z1 = b1 - a1 b0 and a2 z0 + z1 = b2 - a2 b0
+            let (c0, c1) = (b1 - a1 * b0, b2 - a2 * b0);
+            let z0 = (c0 + c1) / den;
+            let z1 = c1 - a2 * z0;
+            zi.push([scale * z0, scale * z1]);
+            scale *= (b0 + b1 + b2) / den;
+        }
+        Ok(Lowpass {
+            sections,
+            zi,
+            padlen,
+        })
+    }
+
+    /// Whether the filter does nothing.
+    pub fn is_identity(&self) -> bool {
+        self.sections.is_empty()
+    }
+
+    /// Run the sections once over `y` in place, started at `x0` times the steady state.
+    fn run(&self, y: &mut [f64], x0: f64) {
+        let ns = self.sections.len();
+        // up to 8 sections on the stack (order 16), more on the heap
+        let mut stack = [[0.0f64; 2]; 8];
+        let mut heap = Vec::new();
+        let st: &mut [[f64; 2]] = if ns <= 8 {
+            &mut stack[..ns]
+        } else {
+            heap.resize(ns, [0.0; 2]);
+            &mut heap[..]
+        };
+        for (s, z) in st.iter_mut().zip(&self.zi) {
+            *s = [z[0] * x0, z[1] * x0];
+        }
+        for yk in y.iter_mut() {
+            let mut x = *yk;
+            for (c, s) in self.sections.iter().zip(st.iter_mut()) {
+                let out = c[0] * x + s[0];
+                s[0] = c[1] * x - c[4] * out + s[1];
+                s[1] = c[2] * x - c[5] * out;
+                x = out;
+            }
+            *yk = x;
+        }
+    }
+
+    /// The zero-phase filtered signal (a copy when the filter is the identity).
+    pub fn filtfilt(&self, y: &[f64]) -> Vec<f64> {
+        let n = y.len();
+        if self.is_identity() || n == 0 {
+            return y.to_vec();
+        }
+        let edge = self.padlen.min(n - 1);
+        let mut ext = Vec::with_capacity(n + 2 * edge);
+        let (first, last) = (y[0], y[n - 1]);
+        for k in (1..=edge).rev() {
+            ext.push(2.0 * first - y[k]);
+        }
+        ext.extend_from_slice(y);
+        for k in 1..=edge {
+            ext.push(2.0 * last - y[n - 1 - k]);
+        }
+        let x0 = ext[0];
+        self.run(&mut ext, x0);
+        ext.reverse();
+        let y0 = ext[0];
+        self.run(&mut ext, y0);
+        ext.reverse();
+        ext.drain(..edge);
+        ext.truncate(n);
+        ext
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn constant_passes_unchanged() {
+        // a second-order Butterworth at 0.1 of Nyquist (scipy.signal.butter(2, 0.1))
+        let s = [
+            0.020083365564211232,
+            0.040166731128422464,
+            0.020083365564211232,
+            1.0,
+            -1.5610180758007182,
+            0.6413515380575631,
+        ];
+        let f = Lowpass::new(vec![s], 9).unwrap();
+        let y = f.filtfilt(&[3.5; 50]);
+        for v in y {
+            assert!((v - 3.5).abs() < 1e-12, "{v}");
+        }
+    }
+
+    #[test]
+    fn line_passes_unchanged() {
+        let s = [
+            0.020083365564211232,
+            0.040166731128422464,
+            0.020083365564211232,
+            1.0,
+            -1.5610180758007182,
+            0.6413515380575631,
+        ];
+        let f = Lowpass::new(vec![s, s], 12).unwrap();
+        let x: Vec<f64> = (0..200).map(|k| 0.3 * k as f64 - 2.0).collect();
+        let y = f.filtfilt(&x);
+        // zero phase: away from the ends the forward lag and the backward lead cancel
+        for (a, b) in x.iter().zip(&y).skip(80).take(40) {
+            assert!((a - b).abs() < 1e-6, "{a} {b}");
+        }
+    }
+
+    #[test]
+    fn rejects_bad_sections() {
+        assert!(Lowpass::new(vec![[1.0, 0.0, 0.0, 2.0, 0.0, 0.0]], 3).is_err());
+        assert!(Lowpass::new(vec![[1.0, f64::NAN, 0.0, 1.0, 0.0, 0.0]], 3).is_err());
+        assert!(Lowpass::new(vec![[1.0, 0.0, 0.0, 1.0, -2.0, 1.0]], 3).is_err());
+    }
+}

@@ -1,0 +1,717 @@
+//! Inverse dynamics of a recorded axis: the force a model needs along the measured
+//! motion, the residual against the motor force, and its sensitivities to the friction
+//! parameters.
+//!
+//! A [`Record`] holds a recording prepared once (low-passed position, its acceleration,
+//! the velocity that drives the bristles, the motor force and the parallel low-pass
+//! [`Lowpass`]); every call then takes a [`Model`]. The residual is
+//!
+//! `r = filt(F_m') - m*a - filt(F_friction + F_effects)`
+//!
+//! where `F_m'` is the motor force after the model's `delay`, `deadband` and
+//! `current_lag`, `F_friction` the LuGre force with its bristles advanced over each
+//! sample interval with the velocity (and friction scale) at its middle, and `filt` the
+//! zero-phase low-pass applied to the position. With a `resonance` the motor carries
+//! `(1 - r)*m*a` plus the force its coupling passes to the load, the load simulated
+//! along the measured motion ([`crate::servo::load_coupling`]).
+//!
+//! The algorithm is fixed in `docs/DESIGN.md` ("Inverse dynamics") and repeated step for
+//! step by the NumPy twin `lugre.reference.InverseRecord`.
+
+mod filter;
+
+pub use filter::Lowpass;
+
+use crate::error::{check_finite, check_len, Error, Result};
+use crate::friction::{friction_force_general_into, LugreParams, StaticSet};
+use crate::servo::{load_coupling, CouplingOptions, Effect, Model};
+
+/// Substeps multiplier of the load simulation behind a `resonance` (the load's bristles
+/// then trail the samples by 1/8 of an interval, not by half of one).
+pub const COUPLING_SUBSTEPS: usize = 4;
+
+/// A base friction parameter, by its path in the model file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BaseParam {
+    /// `fc` of a set (`true`: positive).
+    Fc(bool),
+    /// `fs` of a set.
+    Fs(bool),
+    /// `sigma2` of a set.
+    Sigma2(bool),
+    /// `vs` of a set.
+    Vs(bool),
+    /// `sigma0`.
+    Sigma0,
+    /// `sigma1`.
+    Sigma1,
+}
+
+impl BaseParam {
+    /// Parse a path such as `positive.fc` or `sigma0`.
+    pub fn parse(name: &str) -> Result<BaseParam> {
+        let side = |s: &str| match s {
+            "positive" => Some(true),
+            "negative" => Some(false),
+            _ => None,
+        };
+        let bad = || {
+            Error::input(
+                "names",
+                format!(
+                    "unknown friction parameter {name:?}: use sigma0, sigma1 or \
+                     positive/negative.fc, .fs, .sigma2, .vs"
+                ),
+            )
+        };
+        match name {
+            "sigma0" => return Ok(BaseParam::Sigma0),
+            "sigma1" => return Ok(BaseParam::Sigma1),
+            _ => {}
+        }
+        let (s, k) = name.split_once('.').ok_or_else(bad)?;
+        let pos = side(s).ok_or_else(bad)?;
+        match k {
+            "fc" => Ok(BaseParam::Fc(pos)),
+            "fs" => Ok(BaseParam::Fs(pos)),
+            "sigma2" => Ok(BaseParam::Sigma2(pos)),
+            "vs" => Ok(BaseParam::Vs(pos)),
+            _ => Err(bad()),
+        }
+    }
+
+    /// `(d g/d theta, d sigma2/d theta)` of the set that acts at `v` (unscaled).
+    #[inline(always)]
+    fn dg(self, set: &StaticSet<f64>, positive: bool, v: f64, exponent: f64) -> (f64, f64) {
+        let own = |p: bool| p == positive;
+        match self {
+            BaseParam::Fc(p) if own(p) => (1.0 - stribeck_e(set, v, exponent).0, 0.0),
+            BaseParam::Fs(p) if own(p) => (stribeck_e(set, v, exponent).0, 0.0),
+            BaseParam::Vs(p) if own(p) => {
+                let (e, pw) = stribeck_e(set, v, exponent);
+                ((set.fs - set.fc) * e * exponent * pw / set.vs, 0.0)
+            }
+            BaseParam::Sigma2(p) if own(p) => (0.0, 1.0),
+            _ => (0.0, 0.0),
+        }
+    }
+}
+
+/// `(exp(-|v/vs|^n), |v/vs|^n)`.
+#[inline(always)]
+fn stribeck_e(set: &StaticSet<f64>, v: f64, exponent: f64) -> (f64, f64) {
+    let r = (v / set.vs).abs();
+    let p = if exponent == 2.0 {
+        r * r
+    } else {
+        r.powf(exponent)
+    };
+    ((-p).exp(), p)
+}
+
+/// `g(v)` of the set acting at `v` (exponent 2 as [`StaticSet::g`]).
+#[inline(always)]
+fn g_of(p: &LugreParams<f64>, v: f64, exponent: Option<f64>) -> f64 {
+    match exponent {
+        Some(e) => p.set(v).g_shaped(v, e),
+        None => p.set(v).g(v),
+    }
+}
+
+/// Linear interpolation as `numpy.interp` (constant beyond the ends, knots exact).
+fn interp_into(x: &[f64], xp: &[f64], fp: &[f64], out: &mut [f64]) {
+    let m = xp.len();
+    for (o, &xv) in out.iter_mut().zip(x) {
+        *o = if xv < xp[0] {
+            fp[0]
+        } else if xv >= xp[m - 1] {
+            fp[m - 1]
+        } else {
+            // largest j with xp[j] <= xv
+            let j = xp.partition_point(|&p| p <= xv) - 1;
+            if xp[j] == xv {
+                fp[j]
+            } else {
+                let slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]);
+                slope * (xv - xp[j]) + fp[j]
+            }
+        };
+    }
+}
+
+/// The value at the middle of each sample interval (the last sample kept).
+fn midpoints(a: &[f64]) -> Vec<f64> {
+    let n = a.len();
+    let mut h = Vec::with_capacity(n);
+    for k in 0..n.saturating_sub(1) {
+        h.push(0.5 * (a[k] + a[k + 1]));
+    }
+    if n > 0 {
+        h.push(a[n - 1]);
+    }
+    h
+}
+
+/// Sensitivities of the LuGre force along a record.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Sensitivities {
+    /// The unfiltered LuGre force [N] (as [`Record::base_friction`]).
+    pub force: Vec<f64>,
+    /// One filtered column `d filt(F)/d theta` per parameter.
+    pub columns: Vec<Vec<f64>>,
+    /// Whether each unfiltered column has a non-zero element.
+    pub nonzero: Vec<bool>,
+}
+
+/// A recording prepared for inverse dynamics (all arrays of one length).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Record {
+    dt: f64,
+    t: Vec<f64>,
+    x: Vec<f64>,
+    x_drive: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+    fm: Vec<f64>,
+    fm_f: Vec<f64>,
+    filter: Lowpass,
+}
+
+impl Record {
+    /// A record from its prepared signals.
+    ///
+    /// `t`: time from the origin of time-dependent effects [s]; `x`: low-passed position
+    /// [m]; `x_drive`, `v`: lightly filtered position and the velocity that drives the
+    /// bristles; `a`: acceleration of `x`; `fm`: motor force [N]; `fm_f`: `fm` filtered;
+    /// `dt`: sample interval [s]; `filter`: the parallel low-pass.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        t: Vec<f64>,
+        x: Vec<f64>,
+        x_drive: Vec<f64>,
+        v: Vec<f64>,
+        a: Vec<f64>,
+        fm: Vec<f64>,
+        fm_f: Vec<f64>,
+        dt: f64,
+        filter: Lowpass,
+    ) -> Result<Record> {
+        let n = t.len();
+        if n < 2 {
+            return Err(Error::input("t", "needs at least two samples"));
+        }
+        for (name, a) in [
+            ("t", &t),
+            ("x", &x),
+            ("x_drive", &x_drive),
+            ("v", &v),
+            ("a", &a),
+            ("fm", &fm),
+            ("fm_f", &fm_f),
+        ] {
+            check_len(name, a, n, "t")?;
+            check_finite(name, a)?;
+        }
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(Error::parameter(
+                "dt",
+                dt,
+                "must be a finite sample interval greater than zero [s]",
+            ));
+        }
+        Ok(Record {
+            dt,
+            t,
+            x,
+            x_drive,
+            v,
+            a,
+            fm,
+            fm_f,
+            filter,
+        })
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    /// Never empty (at least two samples).
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+
+    /// The parallel low-pass of a signal of the record's length.
+    pub fn filt(&self, y: &[f64]) -> Vec<f64> {
+        self.filter.filtfilt(y)
+    }
+
+    /// Product of the `position_friction` and `drift` scales, in the order of the
+    /// effects, or `None` without them.
+    pub fn friction_scale(&self, model: &Model) -> Option<Vec<f64>> {
+        let n = self.len();
+        let mut s: Option<Vec<f64>> = None;
+        let mut f = vec![0.0; n];
+        for e in &model.effects {
+            match e {
+                Effect::PositionFriction { positions, scale } => {
+                    interp_into(&self.x, positions, scale, &mut f);
+                }
+                Effect::Drift {
+                    gain,
+                    time_constant,
+                } => {
+                    for (o, &t) in f.iter_mut().zip(&self.t) {
+                        *o = 1.0 - gain * (1.0 - (-t / time_constant).exp());
+                    }
+                }
+                _ => continue,
+            }
+            match s.as_mut() {
+                None => s = Some(f.clone()),
+                Some(acc) => acc.iter_mut().zip(&f).for_each(|(a, b)| *a *= b),
+            }
+        }
+        s
+    }
+
+    /// Bristle states at the samples, advanced over each interval with the velocity and
+    /// scale at its middle; with the scale at the samples (or `None`).
+    fn bristles(&self, model: &Model, exponent: Option<f64>) -> (Vec<f64>, Option<Vec<f64>>) {
+        let s = self.friction_scale(model);
+        let vh = midpoints(&self.v);
+        let sh = s.as_deref().map(midpoints);
+        let n = self.len();
+        let mut f = vec![0.0; n];
+        let mut z = vec![0.0; n];
+        friction_force_general_into(
+            &model.friction,
+            &vh,
+            &[self.dt],
+            0.0,
+            sh.as_deref(),
+            exponent,
+            &mut f,
+            Some(&mut z),
+        );
+        (z, s)
+    }
+
+    /// Unfiltered LuGre force at the samples (position/drift scales and Stribeck
+    /// exponent of the model included).
+    pub fn base_friction(&self, model: &Model) -> Vec<f64> {
+        let exponent = exponent_of(model);
+        let (z, s) = self.bristles(model, exponent);
+        let p = &model.friction;
+        let mut out = vec![0.0; self.len()];
+        for k in 0..self.len() {
+            let sc = s.as_ref().map_or(1.0, |s| s[k]);
+            out[k] = match exponent {
+                Some(e) => p.eval_shaped(z[k], self.v[k], sc, e).1,
+                None => p.eval(z[k], self.v[k], sc).1,
+            };
+        }
+        out
+    }
+
+    /// Unfiltered sum of the effect forces (cogging, spring, offset, drag).
+    pub fn effect_force(&self, model: &Model) -> Vec<f64> {
+        let mut out = vec![0.0; self.len()];
+        for e in &model.effects {
+            match e {
+                Effect::Cogging {
+                    amplitude,
+                    pitch,
+                    phase,
+                    harmonics,
+                } => {
+                    let w = 2.0 * core::f64::consts::PI / pitch;
+                    for (o, &x) in out.iter_mut().zip(&self.x) {
+                        *o += amplitude * (w * x + phase).sin();
+                    }
+                    for (j, (amp, ph)) in harmonics.iter().enumerate() {
+                        let wj = (j + 2) as f64 * w;
+                        for (o, &x) in out.iter_mut().zip(&self.x) {
+                            *o += amp * (wj * x + ph).sin();
+                        }
+                    }
+                }
+                Effect::Spring { stiffness, x0 } => {
+                    for (o, &x) in out.iter_mut().zip(&self.x) {
+                        *o += stiffness * (x - x0);
+                    }
+                }
+                Effect::Offset { force } => out.iter_mut().for_each(|o| *o += force),
+                Effect::Drag { coefficient } => {
+                    for (o, &v) in out.iter_mut().zip(&self.v) {
+                        *o += coefficient * v.abs() * v;
+                    }
+                }
+                _ => {}
+            }
+        }
+        out
+    }
+
+    /// Unfiltered force the `resonance` coupling passes to the load, the load simulated
+    /// along the drive motion with its friction, the friction scales and the effect
+    /// forces on it.
+    pub fn coupling_force(&self, model: &Model) -> Result<Vec<f64>> {
+        let scale = self.friction_scale(model);
+        let extra = self.effect_force(model);
+        let opts = CouplingOptions {
+            scale: scale.as_deref(),
+            extra: Some(&extra),
+            z0: 0.0,
+            substeps: COUPLING_SUBSTEPS,
+        };
+        Ok(load_coupling(model, &self.x_drive, &self.v, self.dt, &opts)?.force)
+    }
+
+    /// Filtered force the model needs besides the motor: `m*a + F_friction + F_effects`
+    /// (with a `resonance`: `(1 - r)*m*a + F_coupling`).
+    pub fn model_force(&self, model: &Model) -> Result<Vec<f64>> {
+        let m = total_mass(model);
+        let res = model.effects.iter().find_map(|e| match e {
+            Effect::Resonance { load_fraction, .. } => Some(*load_fraction),
+            _ => None,
+        });
+        let (ma, f) = match res {
+            None => {
+                let mut f = self.base_friction(model);
+                let e = self.effect_force(model);
+                f.iter_mut().zip(&e).for_each(|(a, b)| *a += b);
+                (m, self.filt(&f))
+            }
+            Some(r) => ((1.0 - r) * m, self.filt(&self.coupling_force(model)?)),
+        };
+        Ok(self.a.iter().zip(&f).map(|(a, f)| ma * a + f).collect())
+    }
+
+    /// Filtered motor force after the model's `delay`, `deadband` and `current_lag`
+    /// (in this order).
+    pub fn motor_force(&self, model: &Model) -> Vec<f64> {
+        let mut delay = None;
+        let mut band = None;
+        let mut lag = None;
+        for e in &model.effects {
+            match e {
+                Effect::Delay { seconds } if *seconds > 0.0 => delay = Some(*seconds),
+                Effect::Deadband { current } if *current > 0.0 => {
+                    band = Some(current * model.axis.force_constant)
+                }
+                Effect::CurrentLag { bandwidth_hz } => lag = Some(*bandwidth_hz),
+                _ => {}
+            }
+        }
+        if delay.is_none() && band.is_none() && lag.is_none() {
+            return self.fm_f.clone();
+        }
+        let mut f = self.fm.clone();
+        if let Some(d) = delay {
+            let ts: Vec<f64> = self.t.iter().map(|t| t - d).collect();
+            interp_into(&ts, &self.t, &self.fm, &mut f);
+        }
+        if let Some(b) = band {
+            for y in f.iter_mut() {
+                *y = deadband(*y, b);
+            }
+        }
+        if let Some(bw) = lag {
+            lag_foh(&mut f, bw, self.dt);
+        }
+        self.filt(&f)
+    }
+
+    /// Force residual `filt(F_m') - m*a - filt(F_friction + F_effects)` [N].
+    pub fn residual(&self, model: &Model) -> Result<Vec<f64>> {
+        let mut r = self.motor_force(model);
+        let f = self.model_force(model)?;
+        r.iter_mut().zip(&f).for_each(|(a, b)| *a -= b);
+        Ok(r)
+    }
+
+    /// [`Record::residual`] of several models, in parallel (rayon); the first error
+    /// in the order of `models` when any fails.
+    pub fn residuals(&self, models: &[Model]) -> Result<Vec<Vec<f64>>> {
+        use rayon::prelude::*;
+        models.par_iter().map(|m| self.residual(m)).collect()
+    }
+
+    /// The LuGre force of [`Record::base_friction`] and its filtered derivatives with
+    /// respect to `params`, propagated exactly through the bristle update.
+    pub fn base_sensitivities(&self, model: &Model, params: &[BaseParam]) -> Sensitivities {
+        let n = self.len();
+        let q = params.len();
+        let exponent = exponent_of(model);
+        let ex = exponent.unwrap_or(2.0);
+        let p = &model.friction;
+        let s0 = p.sigma0;
+        let s1 = p.sigma1;
+        let s = self.friction_scale(model);
+        let sh = s.as_deref().map(midpoints);
+        let vh = midpoints(&self.v);
+        let mut force = vec![0.0; n];
+        let mut cols = vec![vec![0.0; n]; q];
+        let mut dz = vec![0.0; q];
+        let mut z = 0.0;
+        for k in 0..n {
+            // force at z_k, v_k
+            let v = self.v[k];
+            let sc = s.as_ref().map_or(1.0, |s| s[k]);
+            let pos = v >= 0.0;
+            let set = p.set(v);
+            let g = sc * g_of(p, v, exponent);
+            let w = v - s0 * v.abs() * z / g;
+            force[k] = s0 * z + s1 * w + set.sigma2 * v;
+            for (j, par) in params.iter().enumerate() {
+                let (dg0, ds2) = par.dg(set, pos, v, ex);
+                let dg = sc * dg0;
+                let ds0 = if *par == BaseParam::Sigma0 { 1.0 } else { 0.0 };
+                let ds1 = if *par == BaseParam::Sigma1 { 1.0 } else { 0.0 };
+                let dw = -v.abs() * (ds0 * z / g + s0 * dz[j] / g - s0 * z * dg / (g * g));
+                cols[j][k] = ds0 * z + s0 * dz[j] + ds1 * w + s1 * dw + ds2 * v;
+            }
+            // advance z over [t_k, t_k+1) with the midpoint velocity and scale
+            if k + 1 == n {
+                break;
+            }
+            let u = vh[k];
+            if u == 0.0 {
+                continue;
+            }
+            let su = sh.as_ref().map_or(1.0, |s| s[k]);
+            let upos = u >= 0.0;
+            let uset = p.set(u);
+            let gh = su * g_of(p, u, exponent);
+            let sign = if u > 0.0 { 1.0 } else { -1.0 };
+            let zss = sign * gh / s0;
+            let e = (-(s0 * u.abs() * self.dt / gh)).exp();
+            for (j, par) in params.iter().enumerate() {
+                let dgh = su * par.dg(uset, upos, u, ex).0;
+                let ds0 = if *par == BaseParam::Sigma0 { 1.0 } else { 0.0 };
+                let dzss = sign * (dgh / s0 - gh * ds0 / (s0 * s0));
+                let da = u.abs() * self.dt * (ds0 / gh - s0 * dgh / (gh * gh));
+                dz[j] = dzss * (1.0 - e) + e * dz[j] - (z - zss) * e * da;
+            }
+            z = p.advance_z(z, u, gh, self.dt);
+        }
+        let nonzero = cols.iter().map(|c| c.iter().any(|&x| x != 0.0)).collect();
+        let columns = cols.iter().map(|c| self.filt(c)).collect();
+        Sensitivities {
+            force,
+            columns,
+            nonzero,
+        }
+    }
+}
+
+/// The model's Stribeck exponent when it is not 2.
+fn exponent_of(model: &Model) -> Option<f64> {
+    model.stribeck_exponent().filter(|&e| e != 2.0)
+}
+
+/// Axis mass plus every `mass` effect.
+fn total_mass(model: &Model) -> f64 {
+    model.total_mass()
+}
+
+/// `sign(f)*max(|f| - band, 0)`.
+#[inline]
+pub fn deadband(f: f64, band: f64) -> f64 {
+    let m = (f.abs() - band).max(0.0);
+    if f > 0.0 {
+        m
+    } else if f < 0.0 {
+        -m
+    } else {
+        0.0
+    }
+}
+
+/// First-order lag, in place, of a signal interpolated linearly between its samples
+/// (exact): `y[n] = c*y[n-1] + b1*f[n] + (1 - c - b1)*f[n-1]`, `a = 2*pi*bw*dt`,
+/// `c = exp(-a)`, `b1 = 1 - (1 - c)/a`, started at rest at `f[0]`.
+pub fn lag_foh(f: &mut [f64], bandwidth_hz: f64, dt: f64) {
+    let a = 2.0 * core::f64::consts::PI * bandwidth_hz * dt;
+    let c = (-a).exp();
+    let b1 = 1.0 - (1.0 - c) / a;
+    let b2 = 1.0 - c - b1;
+    if f.is_empty() {
+        return;
+    }
+    let mut state = (1.0 - b1) * f[0];
+    for y in f.iter_mut() {
+        let x = *y;
+        let out = b1 * x + state;
+        state = b2 * x + c * out;
+        *y = out;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(n: usize) -> Record {
+        let dt = 1e-3;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+        let x: Vec<f64> = t.iter().map(|t| 0.02 * (2.0 * t).sin()).collect();
+        let v: Vec<f64> = t.iter().map(|t| 0.04 * (2.0 * t).cos()).collect();
+        let a: Vec<f64> = t.iter().map(|t| -0.08 * (2.0 * t).sin()).collect();
+        let fm: Vec<f64> = v.iter().map(|v| 40.0 * v.signum() + 300.0 * v).collect();
+        Record::new(
+            t,
+            x.clone(),
+            x,
+            v,
+            a,
+            fm.clone(),
+            fm,
+            dt,
+            Lowpass::identity(),
+        )
+        .unwrap()
+    }
+
+    fn side(fr: &mut LugreParams<f64>, pos: bool) -> &mut StaticSet<f64> {
+        if pos {
+            &mut fr.positive
+        } else {
+            &mut fr.negative
+        }
+    }
+
+    fn bump(x: &mut f64, h: f64) -> f64 {
+        *x += h;
+        h
+    }
+
+    #[test]
+    fn sensitivities_match_differences() {
+        let rec = record(3000);
+        let mut m = Model::paper();
+        m.friction.sigma0 = 2e3; // slow bristles: presliding visible at 1 kHz
+        let names = [
+            "positive.fc",
+            "positive.fs",
+            "positive.sigma2",
+            "positive.vs",
+            "negative.fc",
+            "negative.fs",
+            "negative.sigma2",
+            "negative.vs",
+            "sigma0",
+            "sigma1",
+        ];
+        let params: Vec<BaseParam> = names.iter().map(|n| BaseParam::parse(n).unwrap()).collect();
+        let sens = rec.base_sensitivities(&m, &params);
+        let f0 = rec.base_friction(&m);
+        for (a, b) in sens.force.iter().zip(&f0) {
+            assert_eq!(a, b);
+        }
+        for (j, name) in names.iter().enumerate() {
+            let mut m2 = m.clone();
+            let fr = &mut m2.friction;
+            let h = match params[j] {
+                BaseParam::Fc(p) => bump(&mut side(fr, p).fc, 1e-6),
+                BaseParam::Fs(p) => bump(&mut side(fr, p).fs, 1e-6),
+                BaseParam::Sigma2(p) => bump(&mut side(fr, p).sigma2, 1e-5),
+                BaseParam::Vs(p) => bump(&mut side(fr, p).vs, 1e-9),
+                BaseParam::Sigma0 => bump(&mut fr.sigma0, 1e-3),
+                BaseParam::Sigma1 => bump(&mut fr.sigma1, 1e-5),
+            };
+            let f1 = rec.base_friction(&m2);
+            let scale = sens.columns[j].iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            assert!(scale > 0.0, "{name}");
+            for k in 0..f0.len() {
+                let fd = (f1[k] - f0[k]) / h;
+                assert!(
+                    (fd - sens.columns[j][k]).abs() < 1e-4 * scale,
+                    "{name} at {k}: {fd} vs {}",
+                    sens.columns[j][k]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn residual_zero_for_matching_force() {
+        let rec = record(500);
+        let m = Model::paper();
+        // a motor force equal to the model's force leaves no residual
+        let need = rec.model_force(&m).unwrap();
+        let rec2 = Record::new(
+            rec.t.clone(),
+            rec.x.clone(),
+            rec.x_drive.clone(),
+            rec.v.clone(),
+            rec.a.clone(),
+            need.clone(),
+            need,
+            rec.dt,
+            Lowpass::identity(),
+        )
+        .unwrap();
+        let r = rec2.residual(&m).unwrap();
+        assert!(r.iter().all(|x| x.abs() < 1e-9));
+    }
+
+    #[test]
+    fn residuals_in_parallel_as_one_by_one() {
+        let rec = record(800);
+        let mut models = vec![Model::paper(); 3];
+        models[1].effects.push(Effect::Offset { force: 3.0 });
+        models[2].effects.push(Effect::Resonance {
+            frequency_hz: 20.0,
+            damping_ratio: 0.05,
+            load_fraction: 0.5,
+        });
+        let all = rec.residuals(&models).unwrap();
+        for (m, r) in models.iter().zip(&all) {
+            assert_eq!(&rec.residual(m).unwrap(), r);
+        }
+    }
+
+    #[test]
+    fn lag_keeps_a_constant_and_delays_a_ramp() {
+        let mut f = vec![2.0; 10];
+        lag_foh(&mut f, 50.0, 1e-3);
+        assert!(f.iter().all(|y| (y - 2.0).abs() < 1e-12));
+        // a ramp lags by 1/(2 pi bw) once settled
+        let bw = 100.0;
+        let dt = 1e-3;
+        let mut r: Vec<f64> = (0..400).map(|k| k as f64 * dt).collect();
+        lag_foh(&mut r, bw, dt);
+        let lagged = 399.0 * dt - r[399];
+        assert!((lagged - 1.0 / (2.0 * core::f64::consts::PI * bw)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn interp_as_numpy() {
+        let xp = [0.0, 1.0, 3.0];
+        let fp = [1.0, 2.0, 0.0];
+        let mut out = [0.0; 6];
+        interp_into(&[-1.0, 0.0, 0.5, 1.0, 2.0, 4.0], &xp, &fp, &mut out);
+        assert_eq!(out, [1.0, 1.0, 1.5, 2.0, 1.0, 0.0]);
+    }
+
+    #[test]
+    fn bad_names_and_lengths() {
+        assert!(BaseParam::parse("positive.fx").is_err());
+        assert!(BaseParam::parse("mass").is_err());
+        let e = Record::new(
+            vec![0.0, 1.0],
+            vec![0.0],
+            vec![0.0, 1.0],
+            vec![0.0, 1.0],
+            vec![0.0, 1.0],
+            vec![0.0, 1.0],
+            vec![0.0, 1.0],
+            1.0,
+            Lowpass::identity(),
+        );
+        assert!(e.is_err());
+    }
+}

@@ -1,0 +1,280 @@
+//! Bindings of the model handed over once (`_core.Model`) and of the inverse-dynamics
+//! kernel of the diagnosis (`_core.InverseRecord`). No numerics here.
+
+use super::{slice, to_py};
+use crate::error::Error;
+use crate::inverse::{BaseParam, Lowpass, Record};
+use crate::servo::Model;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+use std::sync::Arc;
+
+/// A validated model, parsed once and passed to every call of the core.
+#[pyclass(name = "Model", module = "lugre._core", frozen)]
+pub(crate) struct PyModel {
+    pub(crate) inner: Arc<Model>,
+}
+
+#[pymethods]
+impl PyModel {
+    /// Parse and validate a model from its JSON text.
+    #[new]
+    fn new(py: Python<'_>, model_json: &str) -> PyResult<Self> {
+        let m = Model::from_json(model_json).map_err(|e| to_py(py, e))?;
+        Ok(PyModel { inner: Arc::new(m) })
+    }
+
+    /// Whether the friction satisfies the passivity bound in both directions.
+    fn is_passive(&self) -> bool {
+        self.inner.friction.is_passive()
+    }
+}
+
+/// The model of an argument: a `_core.Model` as it is, JSON text parsed.
+pub(crate) fn model_of(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<Arc<Model>> {
+    if let Ok(m) = obj.downcast::<PyModel>() {
+        return Ok(m.get().inner.clone());
+    }
+    if let Ok(text) = obj.extract::<String>() {
+        return Model::from_json(&text)
+            .map(Arc::new)
+            .map_err(|e| to_py(py, e));
+    }
+    // a lugre.Model: its cached core model
+    if let Ok(core) = obj.call_method0("_core_model") {
+        if let Ok(m) = core.downcast::<PyModel>() {
+            return Ok(m.get().inner.clone());
+        }
+    }
+    let kind = obj.get_type().name().map_or("?".into(), |n| n.to_string());
+    Err(to_py(
+        py,
+        Error::input(
+            "model",
+            format!(
+                "must be a lugre.Model, a lugre._core.Model or the model's JSON text, \
+                 got {kind}"
+            ),
+        ),
+    ))
+}
+
+type F64Array<'py> = Bound<'py, PyArray1<f64>>;
+
+/// A recording prepared for inverse dynamics (see `lugre.inverse` in the crate).
+#[pyclass(name = "InverseRecord", module = "lugre._core", frozen)]
+pub(crate) struct PyInverseRecord {
+    rec: Record,
+}
+
+fn vec_of(name: &str, a: &PyReadonlyArray1<'_, f64>) -> Result<Vec<f64>, Error> {
+    Ok(slice(name, a)?.to_vec())
+}
+
+#[pymethods]
+impl PyInverseRecord {
+    #[new]
+    #[pyo3(signature = (t, x, x_drive, v, a, fm, fm_f, dt, sos=None, padlen=0))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        t: PyReadonlyArray1<'_, f64>,
+        x: PyReadonlyArray1<'_, f64>,
+        x_drive: PyReadonlyArray1<'_, f64>,
+        v: PyReadonlyArray1<'_, f64>,
+        a: PyReadonlyArray1<'_, f64>,
+        fm: PyReadonlyArray1<'_, f64>,
+        fm_f: PyReadonlyArray1<'_, f64>,
+        dt: f64,
+        sos: Option<PyReadonlyArray2<'_, f64>>,
+        padlen: usize,
+    ) -> PyResult<Self> {
+        let rec = (|| -> Result<Record, Error> {
+            let filter = match &sos {
+                None => Lowpass::identity(),
+                Some(s) => {
+                    let s = s.as_array();
+                    if s.ncols() != 6 {
+                        return Err(Error::input(
+                            "sos",
+                            format!(
+                                "has {} columns: give one row [b0, b1, b2, 1, a1, a2] per section",
+                                s.ncols()
+                            ),
+                        ));
+                    }
+                    let rows = s
+                        .rows()
+                        .into_iter()
+                        .map(|r| [r[0], r[1], r[2], r[3], r[4], r[5]])
+                        .collect();
+                    Lowpass::new(rows, padlen)?
+                }
+            };
+            Record::new(
+                vec_of("t", &t)?,
+                vec_of("x", &x)?,
+                vec_of("x_drive", &x_drive)?,
+                vec_of("v", &v)?,
+                vec_of("a", &a)?,
+                vec_of("fm", &fm)?,
+                vec_of("fm_f", &fm_f)?,
+                dt,
+                filter,
+            )
+        })()
+        .map_err(|e| to_py(py, e))?;
+        Ok(PyInverseRecord { rec })
+    }
+
+    fn __len__(&self) -> usize {
+        self.rec.len()
+    }
+
+    /// The parallel low-pass of a signal of the record's length.
+    fn filt<'py>(&self, py: Python<'py>, y: PyReadonlyArray1<'py, f64>) -> PyResult<F64Array<'py>> {
+        let ys = slice("y", &y).map_err(|e| to_py(py, e))?;
+        crate::error::check_len("y", ys, self.rec.len(), "the record").map_err(|e| to_py(py, e))?;
+        Ok(py.detach(|| self.rec.filt(ys)).into_pyarray(py))
+    }
+
+    /// Product of the position and drift scales of friction, or None.
+    fn friction_scale<'py>(
+        &self,
+        py: Python<'py>,
+        model: &Bound<'py, PyAny>,
+    ) -> PyResult<Option<F64Array<'py>>> {
+        let m = model_of(py, model)?;
+        Ok(py
+            .detach(|| self.rec.friction_scale(&m))
+            .map(|s| s.into_pyarray(py)))
+    }
+
+    /// Unfiltered LuGre force at the samples.
+    fn base_friction<'py>(
+        &self,
+        py: Python<'py>,
+        model: &Bound<'py, PyAny>,
+    ) -> PyResult<F64Array<'py>> {
+        let m = model_of(py, model)?;
+        Ok(py.detach(|| self.rec.base_friction(&m)).into_pyarray(py))
+    }
+
+    /// Unfiltered sum of the effect forces.
+    fn effect_force<'py>(
+        &self,
+        py: Python<'py>,
+        model: &Bound<'py, PyAny>,
+    ) -> PyResult<F64Array<'py>> {
+        let m = model_of(py, model)?;
+        Ok(py.detach(|| self.rec.effect_force(&m)).into_pyarray(py))
+    }
+
+    /// Unfiltered force of the resonance coupling on the load.
+    fn coupling_force<'py>(
+        &self,
+        py: Python<'py>,
+        model: &Bound<'py, PyAny>,
+    ) -> PyResult<F64Array<'py>> {
+        let m = model_of(py, model)?;
+        let r = py
+            .detach(|| self.rec.coupling_force(&m))
+            .map_err(|e| to_py(py, e))?;
+        Ok(r.into_pyarray(py))
+    }
+
+    /// Filtered force the model needs besides the motor.
+    fn model_force<'py>(
+        &self,
+        py: Python<'py>,
+        model: &Bound<'py, PyAny>,
+    ) -> PyResult<F64Array<'py>> {
+        let m = model_of(py, model)?;
+        let r = py
+            .detach(|| self.rec.model_force(&m))
+            .map_err(|e| to_py(py, e))?;
+        Ok(r.into_pyarray(py))
+    }
+
+    /// Filtered motor force after delay, dead-band and current lag.
+    fn motor_force<'py>(
+        &self,
+        py: Python<'py>,
+        model: &Bound<'py, PyAny>,
+    ) -> PyResult<F64Array<'py>> {
+        let m = model_of(py, model)?;
+        Ok(py.detach(|| self.rec.motor_force(&m)).into_pyarray(py))
+    }
+
+    /// Force residual.
+    fn residual<'py>(&self, py: Python<'py>, model: &Bound<'py, PyAny>) -> PyResult<F64Array<'py>> {
+        let m = model_of(py, model)?;
+        let r = py
+            .detach(|| self.rec.residual(&m))
+            .map_err(|e| to_py(py, e))?;
+        Ok(r.into_pyarray(py))
+    }
+
+    /// Residuals of several models (one column each), computed in parallel.
+    fn residuals<'py>(
+        &self,
+        py: Python<'py>,
+        models: Vec<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let ms = models
+            .iter()
+            .map(|m| model_of(py, m).map(|m| (*m).clone()))
+            .collect::<PyResult<Vec<_>>>()?;
+        let n = self.rec.len();
+        let q = ms.len();
+        let flat = py
+            .detach(|| -> Result<Vec<f64>, Error> {
+                let rs = self.rec.residuals(&ms)?;
+                let mut flat = vec![0.0; n * q];
+                for (j, c) in rs.iter().enumerate() {
+                    for (k, &x) in c.iter().enumerate() {
+                        flat[k * q + j] = x;
+                    }
+                }
+                Ok(flat)
+            })
+            .map_err(|e| to_py(py, e))?;
+        let out = Array2::from_shape_vec((n, q), flat)
+            .map_err(|e| to_py(py, Error::input("models", e.to_string())))?;
+        Ok(out.into_pyarray(py))
+    }
+
+    /// `(force, J, nonzero)`: the unfiltered LuGre force, its filtered derivatives with
+    /// respect to the named parameters (one column each) and whether each unfiltered
+    /// column is non-zero.
+    #[allow(clippy::type_complexity)]
+    fn base_sensitivities<'py>(
+        &self,
+        py: Python<'py>,
+        model: &Bound<'py, PyAny>,
+        names: Vec<String>,
+    ) -> PyResult<(F64Array<'py>, Bound<'py, PyArray2<f64>>, Vec<bool>)> {
+        let m = model_of(py, model)?;
+        let params = names
+            .iter()
+            .map(|n| BaseParam::parse(n))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| to_py(py, e))?;
+        let n = self.rec.len();
+        let q = params.len();
+        let (s, flat) = py.detach(|| {
+            let s = self.rec.base_sensitivities(&m, &params);
+            let mut flat = vec![0.0; n * q];
+            for (j, c) in s.columns.iter().enumerate() {
+                for (k, &x) in c.iter().enumerate() {
+                    flat[k * q + j] = x;
+                }
+            }
+            (s, flat)
+        });
+        let jac = Array2::from_shape_vec((n, q), flat)
+            .map_err(|e| to_py(py, Error::input("names", e.to_string())))?;
+        Ok((s.force.into_pyarray(py), jac.into_pyarray(py), s.nonzero))
+    }
+}
