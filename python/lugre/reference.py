@@ -1,10 +1,22 @@
 """The NumPy reference: the algorithms of ``docs/DESIGN.md`` in plain Python.
 
-Same names, signatures and results as the Rust-backed :mod:`lugre` API, written with
-NumPy alone (no SciPy) as loops over Python floats that repeat the core's
-(``src/friction/mod.rs``, ``src/servo/sim.rs``) operations in the same order, so that
-the two agree to rounding (about 1e-12). It is slow (a few microseconds per plant step)
-and meant for checking the core and for reading.
+Same names, signatures, results and errors as the Rust-backed :mod:`lugre` API, written
+with NumPy alone (no SciPy) as loops over Python floats that repeat the core's
+(``src/friction/mod.rs``, ``src/servo/sim.rs``, ``src/estimate/``) operations in the
+same order, so that the two agree bit for bit. It is slow (a few microseconds per plant
+step) and meant for checking the core and for reading. Never calls :mod:`lugre._core`.
+
+- kernels here: :func:`stribeck`, :func:`friction_force`, :func:`simulate`,
+  :func:`simulate_batch`, :func:`load_coupling`;
+- estimators in their own modules, imported on first use: :func:`fit_static`
+  (``_reference_static``), :func:`fit_dynamic` (``_reference_dynamic``), built on
+  Nelder-Mead as the core runs it (``_reference_nm``) and the robust weights
+  (``_reference_robust``); their results are the facade's :class:`StaticFit` and
+  :class:`DynamicFit`;
+- :func:`evaluate` runs the diagnosis's preparation of the record (SciPy filters) with
+  the residual from :class:`InverseRecord`, the NumPy twin of the inverse-dynamics
+  kernel (``_reference_inverse``);
+- :func:`load_model` and :func:`save_model` are the facade's own (Python) functions.
 
 Examples
 --------
@@ -20,25 +32,76 @@ from __future__ import annotations
 import math
 from bisect import bisect_right
 from collections import deque
+from collections.abc import Sequence
 from numbers import Integral
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
 from ._reference_inverse import InverseRecord
 from ._result import CouplingResult, SimResult
 from .exceptions import DataError, InputError, ModelError, ParameterError, _fmt_f64
-from .model import ModelLike, _as_model, _CurrentLoop, _Friction, _Parsed, _StaticSet
+from .model import (
+    ModelLike,
+    _as_model,
+    _CurrentLoop,
+    _Friction,
+    _parse,
+    _Parsed,
+    _StaticSet,
+    load_model,
+    save_model,
+)
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ._reference_dynamic import DynamicFit, fit_dynamic
+    from ._reference_evaluate import evaluate
+    from ._reference_static import StaticFit, fit_static
 
 __all__ = [
     "CouplingResult",
+    "DynamicFit",
     "InverseRecord",
     "SimResult",
+    "StaticFit",
+    "evaluate",
+    "fit_dynamic",
+    "fit_static",
     "friction_force",
     "load_coupling",
+    "load_model",
+    "save_model",
     "simulate",
+    "simulate_batch",
     "stribeck",
 ]
+
+#: Names defined in the ``_reference_*`` modules, imported on first use: the
+#: identification imports the facade's result classes, whose module imports this one.
+_LAZY = {
+    "DirectionFit": "._reference_static",
+    "StaticFit": "._reference_static",
+    "fit_static": "._reference_static",
+    "DynamicFit": "._reference_dynamic",
+    "fit_dynamic": "._reference_dynamic",
+    "evaluate": "._reference_evaluate",
+}
+
+
+def __getattr__(name: str) -> Any:
+    mod = _LAZY.get(name)
+    if mod is None:
+        raise AttributeError(f"module 'lugre.reference' has no attribute {name!r}")
+    from importlib import import_module
+
+    value = getattr(import_module(mod, __package__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
 
 _PI = math.pi
 _exp = math.exp
@@ -47,6 +110,12 @@ _exp = math.exp
 # --------------------------------------------------------------------------------------
 # Input checks (src/error.rs), raising the same information as the core
 # --------------------------------------------------------------------------------------
+
+
+def _parsed(model: ModelLike) -> _Parsed:
+    """The model's numbers, checked here from its document as the core checks its JSON:
+    a :class:`~lugre.Model` built around the checks is refused by both backends alike."""
+    return _parse(_as_model(model)._data)
 
 
 def _array(name: str, a: Any) -> np.ndarray:
@@ -228,7 +297,7 @@ def stribeck(v: Any, model: ModelLike) -> np.ndarray:
     InputError
         ``v`` is not 1-D or holds NaN or inf.
     """
-    p = _as_model(model)._parsed.friction
+    p = _parsed(model).friction
     vv = _array("v", v).tolist()
     _check_finite("v", vv)
     return np.array([_stribeck1(p, x) for x in vv], dtype=np.float64)
@@ -280,7 +349,7 @@ def friction_force(
     ParameterError
         ``z0`` not finite.
     """
-    parsed = _as_model(model)._parsed
+    parsed = _parsed(model)
     p = parsed.friction
     exponent = parsed.stribeck_exponent
     vv = _array("v", v).tolist()
@@ -655,7 +724,25 @@ def simulate(
     DataError
         The simulation diverged.
     """
-    m = _as_model(model)._parsed
+    return _simulate(_parsed(model), t, x_ref, v_ref=v_ref, current=current,
+                     integrator=integrator, substeps=substeps, z0=z0, x0=x0, v0=v0)
+
+
+def _simulate(
+    m: _Parsed,
+    t: Any,
+    x_ref: Any = None,
+    *,
+    v_ref: Any = None,
+    current: Any = None,
+    integrator: str = "exact",
+    substeps: int = 1,
+    z0: float = 0.0,
+    x0: float | None = None,
+    v0: float = 0.0,
+) -> SimResult:
+    """:func:`simulate` of a parsed model (the estimators change its numbers directly,
+    as the core does, without building and checking a document each time)."""
     if integrator not in ("exact", "rk4"):
         raise InputError.at(
             "integrator", f'unknown integrator "{integrator}": use "exact" or "rk4"'
@@ -839,6 +926,41 @@ def simulate(
     return SimResult(ta.copy(), out_x, out_v, out_z, out_i, out_f, out_fm)
 
 
+def simulate_batch(
+    models: Sequence[ModelLike],
+    t: Any,
+    x_ref: Any = None,
+    *,
+    v_ref: Any = None,
+    current: Any = None,
+    integrator: str = "exact",
+    substeps: int = 1,
+    z0: float = 0.0,
+    x0: float | None = None,
+    v0: float = 0.0,
+) -> list[SimResult]:
+    """Simulate many models on the same input: :func:`simulate` for each, in order.
+
+    Parameters are those of :func:`simulate`, with a sequence of models. As in the core,
+    the inputs are converted and every model is checked before the first simulation,
+    and the first model that fails raises.
+
+    Returns
+    -------
+    list of SimResult
+        One per model, in order.
+    """
+    kind, drive = _select_drive(x_ref, v_ref, current)
+    _array("t", t)
+    _array(kind, drive)
+    _check_substeps_type(substeps)
+    models = list(models)
+    for m in models:
+        _parsed(m)
+    return [simulate(m, t, integrator=integrator, substeps=substeps, z0=z0, x0=x0, v0=v0,
+                     **{kind: drive}) for m in models]
+
+
 # --------------------------------------------------------------------------------------
 # The load behind the resonance coupling (src/servo/coupling.rs)
 # --------------------------------------------------------------------------------------
@@ -912,7 +1034,7 @@ def load_coupling(
         The load's state turned non-finite.
     """
     # the facade's conversions, then the core's checks in the core's order
-    parsed = _as_model(model)._parsed
+    parsed = _parsed(model)
     xa = _array("x", x).tolist()
     va = _array("v", v).tolist()
     sc = None if scale is None else _array("scale", scale).tolist()

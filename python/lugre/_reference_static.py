@@ -1,0 +1,859 @@
+"""The static step in Python: the Stribeck curve of each direction from steady-state
+points (``src/estimate/static_fit/``, ``docs/DESIGN.md``), twin of
+:func:`lugre.fit_static`.
+
+For a fixed ``vs`` the curve ``fc + (fs - fc)*phi + sigma2*a``, ``phi = exp(-(a/vs)^2)``,
+is linear: the linear part comes from the 3x3 weighted normal equations (column-scaled
+Cholesky, signs kept by an exhaustive active set), so every weighted problem is a
+search over ``ln vs`` (a bracket, then Nelder-Mead). Starts: a Huber grid over
+``ln vs`` and least trimmed squares on three subset sizes; IRLS with the chosen
+weights from each; the kept points refitted by least squares; the path of smallest
+Tukey loss wins; covariance from the weighted Jacobian.
+
+The operations follow the Rust code in the same order. Where the core's order is that
+of an unstable selection (the subsets of the trimmed fits), sums may be taken in
+another order, so the two agree to the precision of the optimiser's stopping rule,
+not always bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ._reference_nm import NmOptions, minimize
+from ._reference_robust import Weighting, median, robust_scale, t_quantile_975
+from .exceptions import ConvergenceWarning, DataError, InputError, ParameterError, _fmt_f64
+from .identify import DirectionFit, StaticFit
+
+__all__ = ["DirectionFit", "StaticFit", "fit_static"]
+
+MIN_POINTS_PER_DIRECTION = 5
+STATIC_PARAM_NAMES = ("fc", "fs", "sigma2", "vs")
+GRID_NODES = 17
+LTS_CANDIDATES = 4
+SEEDS_PER_NODE = 12
+REFIT_REJECT_MIN = 4.685
+_exp = math.exp
+_MASK = 0xFFFF_FFFF_FFFF_FFFF
+
+P4 = list  # [fc, fs, sigma2, vs]
+
+
+# ---- variable projection (varpro.rs) ----------------------------------------------------
+
+
+def _ln(x: float) -> float:
+    """``f64::ln``: -inf at 0, NaN below (``math.log`` raises there)."""
+    if x > 0.0 or math.isnan(x):
+        return math.log(x)
+    return -math.inf if x == 0.0 else math.nan
+
+
+def _div(a: float, b: float) -> float:
+    """``a / b`` with IEEE results at ``b == 0`` (inf or NaN, as in Rust)."""
+    if b != 0.0:
+        return a / b
+    if a == 0.0 or math.isnan(a):
+        return math.nan
+    return math.copysign(math.inf, a) * math.copysign(1.0, b)
+
+
+def _curve(p: Sequence[float], a: float) -> float:
+    r = a / p[3]
+    return p[0] + (p[1] - p[0]) * _exp(-(r * r)) + p[2] * a
+
+
+def _fill_phi(a: list[float], vs: float, phi: list[float]) -> None:
+    iv = 1.0 / vs
+    for k, ai in enumerate(a):
+        r = ai * iv
+        phi[k] = _exp(-(r * r)) if r * r < 40.0 else 0.0
+
+
+def _inv_sqrt(v: float) -> float | None:
+    return 1.0 / math.sqrt(v) if v > 0.0 and math.isfinite(v) else None
+
+
+class _Normal:
+    """Weighted normal equations of ``(fc - fc_min, fs - fc, sigma2)``."""
+
+    __slots__ = ("b", "m")
+
+    def __init__(self) -> None:
+        self.m = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]
+        self.b = [0.0, 0.0, 0.0]
+
+    def add(self, phi: float, a: float, y: float, w: float) -> None:
+        wp, wa = w * phi, w * a
+        m, b = self.m, self.b
+        m[0][0] += w
+        m[0][1] += wp
+        m[0][2] += wa
+        m[1][1] += wp * phi
+        m[1][2] += wp * a
+        m[2][2] += wa * a
+        b[0] += w * y
+        b[1] += wp * y
+        b[2] += wa * y
+
+    def solve_free(self, free: int) -> list[float] | None:
+        pivot = 1e-13
+        m = self.m
+        x = [0.0, 0.0, 0.0]
+        if free == 0b111:
+            d0, d1, d2 = _inv_sqrt(m[0][0]), _inv_sqrt(m[1][1]), _inv_sqrt(m[2][2])
+            if d0 is None or d1 is None or d2 is None:
+                return None
+            a, b, c = m[0][1] * d0 * d1, m[0][2] * d0 * d2, m[1][2] * d1 * d2
+            p1 = 1.0 - a * a
+            if math.isnan(p1) or p1 <= pivot:
+                return None
+            l11 = math.sqrt(p1)
+            l21 = (c - a * b) / l11
+            p2 = 1.0 - b * b - l21 * l21
+            if math.isnan(p2) or p2 <= pivot:
+                return None
+            l22 = math.sqrt(p2)
+            z0 = self.b[0] * d0
+            z1 = (self.b[1] * d1 - a * z0) / l11
+            z2 = (self.b[2] * d2 - b * z0 - l21 * z1) / l22
+            u2 = z2 / l22
+            u1 = (z1 - l21 * u2) / l11
+            u0 = z0 - a * u1 - b * u2
+            x = [u0 * d0, u1 * d1, u2 * d2]
+        elif free in (0b011, 0b101, 0b110):
+            i, j = {0b011: (0, 1), 0b101: (0, 2), 0b110: (1, 2)}[free]
+            di, dj = _inv_sqrt(m[i][i]), _inv_sqrt(m[j][j])
+            if di is None or dj is None:
+                return None
+            a = m[i][j] * di * dj
+            det = 1.0 - a * a
+            if math.isnan(det) or det <= pivot:
+                return None
+            bi, bj = self.b[i] * di, self.b[j] * dj
+            x[i] = (bi - a * bj) / det * di
+            x[j] = (bj - a * bi) / det * dj
+        elif free in (0b001, 0b010, 0b100):
+            i = {0b001: 0, 0b010: 1, 0b100: 2}[free]
+            mii = m[i][i]
+            if not (mii > 0.0 and math.isfinite(mii)):
+                return None
+            x[i] = self.b[i] / mii
+        return x if all(math.isfinite(v) for v in x) else None
+
+    def quad(self, x: list[float]) -> float:
+        m = self.m
+        mx = [m[0][0] * x[0] + m[0][1] * x[1] + m[0][2] * x[2],
+              m[0][1] * x[0] + m[1][1] * x[1] + m[1][2] * x[2],
+              m[0][2] * x[0] + m[1][2] * x[1] + m[2][2] * x[2]]
+        q = 0.0
+        for k in range(3):
+            q += x[k] * (mx[k] - 2.0 * self.b[k])
+        return q
+
+    def solve_nonneg(self) -> list[float]:
+        x = self.solve_free(0b111)
+        if x is not None and all(v >= 0.0 for v in x):
+            return x
+        best, best_q = [0.0, 0.0, 0.0], 0.0
+        for free in (0b011, 0b101, 0b110, 0b001, 0b010, 0b100):
+            x = self.solve_free(free)
+            if x is not None and all(v >= 0.0 for v in x):
+                q = self.quad(x)
+                if q < best_q:
+                    best, best_q = x, q
+        return best
+
+
+class _Sep:
+    """One direction's points and the separable problem (``Sep`` in varpro.rs)."""
+
+    def __init__(self, a: list[float], y: list[float], fscale: float) -> None:
+        amin = min(a)
+        amax = max([0.0, *a])
+        self.a, self.y = a, y
+        self.fc_min = 1e-9 * fscale
+        self.ln_lo = math.log(amin) - 7.0
+        self.ln_hi = math.log(amax) + 7.0
+        self.phi = [0.0] * len(a)
+
+    def normal(self, w: Sequence[float]) -> _Normal:
+        ne = _Normal()
+        fm = self.fc_min
+        for phi, a, y, wi in zip(self.phi, self.a, self.y, w):
+            if wi != 0.0:
+                ne.add(phi, a, y - fm, wi)
+        return ne
+
+    def params(self, x: list[float], vs: float) -> P4:
+        fc = self.fc_min + x[0]
+        return [fc, fc + x[1], x[2], vs]
+
+    def profile(self, w: Sequence[float], ln_vs: float) -> tuple[float, P4]:
+        if not (self.ln_lo <= ln_vs <= self.ln_hi):
+            return math.inf, [math.nan] * 4
+        vs = _exp(ln_vs)
+        _fill_phi(self.a, vs, self.phi)
+        p = self.params(self.normal(w).solve_nonneg(), vs)
+        d = p[1] - p[0]
+        ss = 0.0
+        for phi, a, y, wi in zip(self.phi, self.a, self.y, w):
+            e = y - (p[0] + d * phi + p[2] * a)
+            ss += wi * e * e
+        return ss, p
+
+    def residuals(self, p: Sequence[float]) -> list[float]:
+        return [y - _curve(p, a) for a, y in zip(self.a, self.y)]
+
+
+def _vp_minimize(sep: _Sep, w: Sequence[float], ln_vs0: float, step: float,
+                 nm: NmOptions, floor: float) -> tuple[P4, int]:
+    """Minimum of the weighted profile over ``ln vs``: a bracket walked downhill, then
+    Nelder-Mead from the vertex of its parabola."""
+
+    def f(x: float) -> float:
+        return sep.profile(w, x)[0] + floor
+
+    xa, xb, xc = ln_vs0 - step, ln_vs0, ln_vs0 + step
+    fa, fb, fc = f(xa), f(xb), f(xc)
+    evals = 3
+    h = step
+    while evals < 40:
+        if fa < fb and fa <= fc:
+            h *= 2.0
+            xc, fc, xb, fb = xb, fb, xa, fa
+            xa = xb - h
+            fa = f(xa)
+        elif fc < fb:
+            h *= 2.0
+            xa, fa, xb, fb = xb, fb, xc, fc
+            xc = xb + h
+            fc = f(xc)
+        else:
+            break
+        evals += 1
+    da, dc = xb - xa, xb - xc
+    den = da * (fb - fc) - dc * (fb - fa)
+    x0 = xb
+    if den != 0.0 and math.isfinite(den):
+        xp = xb - 0.5 * (da * da * (fb - fc) - dc * dc * (fb - fa)) / den
+        if xa < xp < xc:
+            fp = f(xp)
+            evals += 1
+            if fp < fb:
+                x0 = xp
+    simplex = max(1e-3 * h, 1e-7)
+    r = minimize(lambda x: f(x[0]), [x0], [simplex], nm)
+    _, p = sep.profile(w, r.x[0])
+    return p, evals + r.evals + 1
+
+
+# ---- starts (starts.rs) ------------------------------------------------------------------
+
+
+def _grid_nodes(a: list[float], count: int) -> list[float]:
+    amin, amax = min(a), max([0.0, *a])
+    lo, hi = math.log(amin * 0.5), math.log(amax * 2.0)
+    return [_exp(lo + (hi - lo) * k / (count - 1)) for k in range(count)]
+
+
+def _start_values_huber(sep: _Sep) -> P4 | None:
+    """At each ``ln vs`` node a few Huber IRLS steps of the linear fit, scored by the
+    median absolute residual."""
+    n = len(sep.a)
+    huber = Weighting.huber()
+    best: tuple[float, P4] | None = None
+    fscale = sep.fc_min * 1e9
+    for vs in _grid_nodes(sep.a, GRID_NODES):
+        _fill_phi(sep.a, vs, sep.phi)
+        w = [1.0] * n
+        score = math.inf
+        p = [math.nan] * 4
+        for it in range(4):
+            p = sep.params(sep.normal(w).solve_nonneg(), vs)
+            d = p[1] - p[0]
+            e = [y - (p[0] + d * phi + p[2] * a)
+                 for phi, a, y in zip(sep.phi, sep.a, sep.y)]
+            med = median(e)
+            s = max(1.4826 * median([abs(x - med) for x in e]), 1e-12 * fscale)
+            if it == 3:
+                score = median([abs(x) for x in e])
+                break
+            w = [huber.weight(x / s) for x in e]
+        if math.isfinite(score) and (best is None or score < best[0]):
+            best = (score, p)
+    return None if best is None else best[1]
+
+
+def _elemental_seeds(a: list[float], count: int) -> list[list[int]]:
+    """Three-point subsets, one from each third of the speed range, from the core's
+    fixed-seed SplitMix64."""
+    n = len(a)
+    by_speed = sorted(range(n), key=lambda i: a[i])
+    state = 0x2545_F491_4F6C_DD1D
+
+    def nxt(m: int) -> int:
+        nonlocal state
+        state = (state + 0x9E37_79B9_7F4A_7C15) & _MASK
+        z = state
+        z = ((z ^ (z >> 30)) * 0xBF58_476D_1CE4_E5B9) & _MASK
+        z = ((z ^ (z >> 27)) * 0x94D0_49BB_1331_11EB) & _MASK
+        return (z ^ (z >> 31)) % max(m, 1)
+
+    t1, t2 = n // 3, (2 * n) // 3
+    out: list[list[int]] = []
+    if t1 == 0 or t2 == t1:
+        return out
+    while len(out) < count:
+        i = by_speed[nxt(t1)]
+        j = by_speed[t1 + nxt(t2 - t1)]
+        k = by_speed[t2 + nxt(n - t2)]
+        out.append([i, j, k])
+    return out
+
+
+class _Lts:
+    """Least-trimmed-squares work at one ``ln vs`` node (the node's ``phi`` in ``sep``)."""
+
+    def __init__(self, n: int, h: int) -> None:
+        self.h = h
+        self.order = list(range(n))
+
+    @staticmethod
+    def fit(sep: _Sep, sub: Sequence[int], vs: float) -> P4:
+        ne = _Normal()
+        for i in sub:
+            ne.add(sep.phi[i], sep.a[i], sep.y[i] - sep.fc_min, 1.0)
+        return sep.params(ne.solve_nonneg(), vs)
+
+    def cstep(self, sep: _Sep, p: P4) -> tuple[float, P4]:
+        """The trimmed sum of ``p`` and the fit on its ``h`` best points."""
+        d = p[1] - p[0]
+        r2 = []
+        for phi, a, y in zip(sep.phi, sep.a, sep.y):
+            e = y - (p[0] + d * phi + p[2] * a)
+            r2.append(e * e)
+        h = self.h
+        # the core selects the h smallest (select_nth_unstable): the same set, the
+        # sum taken in another order
+        self.order = sorted(range(len(r2)), key=lambda i: r2[i])
+        total = 0.0
+        for i in self.order[:h]:
+            total += r2[i]
+        return total, _Lts.fit(sep, self.order[:h], p[3])
+
+    def concentrate(self, sep: _Sep, p: P4, max_steps: int) -> tuple[float, P4]:
+        obj, nxt = self.cstep(sep, p)
+        cur = p
+        for _ in range(1, max_steps):
+            o, nx = self.cstep(sep, nxt)
+            if math.isnan(o) or o >= obj * (1.0 - 1e-12):
+                if o <= obj:
+                    return o, nxt
+                self.cstep(sep, cur)
+                return obj, cur
+            cur = nxt
+            obj = o
+            nxt = nx
+        return obj, cur
+
+
+def _start_values_lts(sep: _Sep, h: int) -> list[P4]:
+    """Least-trimmed-squares candidates over the ``ln vs`` grid, best first."""
+    n = len(sep.a)
+    nodes = _grid_nodes(sep.a, GRID_NODES)
+    seeds = _elemental_seeds(sep.a, SEEDS_PER_NODE * len(nodes))
+    lts = _Lts(n, h)
+    every = list(range(n))
+    prev: list[int] | None = None
+    glob: tuple[float, P4, list[int]] | None = None
+    node_subsets: list[list[int] | None] = [None] * len(nodes)
+    found_at = 0
+    candidates: list[tuple[float, P4, list[int]]] = []
+    for k, vs in enumerate(nodes):
+        _fill_phi(sep.a, vs, sep.phi)
+        starts = [_Lts.fit(sep, every, vs)]
+        if prev is not None:
+            starts.append(_Lts.fit(sep, prev, vs))
+        if glob is not None and prev != glob[2]:
+            starts.append(_Lts.fit(sep, glob[2], vs))
+        for sd in seeds[k * SEEDS_PER_NODE:(k + 1) * SEEDS_PER_NODE]:
+            starts.append(_Lts.fit(sep, sd, vs))
+        node_best: tuple[float, P4] | None = None
+        for p0 in starts:
+            obj, p = lts.concentrate(sep, p0, 2)
+            if math.isfinite(obj) and (node_best is None or obj < node_best[0]):
+                node_best = (obj, p)
+        if node_best is None:
+            continue
+        obj, p = lts.concentrate(sep, node_best[1], 8)
+        sub = sorted(lts.order[:h])
+        node_subsets[k] = sub
+        prev = sub
+        if math.isfinite(obj):
+            candidates.append((obj, p, sub))
+        if glob is None or obj < glob[0]:
+            glob = (obj, p, sub)
+            found_at = k
+    if glob is None:
+        return []
+    best_sub = glob[2]
+    for k, vs in enumerate(nodes[:found_at]):
+        if node_subsets[k] == best_sub:
+            continue
+        _fill_phi(sep.a, vs, sep.phi)
+        obj, p = lts.concentrate(sep, _Lts.fit(sep, best_sub, vs), 8)
+        if math.isfinite(obj):
+            candidates.append((obj, p, best_sub))
+    candidates.sort(key=lambda c: c[0])
+    out: list[P4] = []
+    seen: list[list[int]] = []
+    for _, p, sub in candidates:
+        if sub not in seen:
+            seen.append(sub)
+            out.append(p)
+            if len(out) == LTS_CANDIDATES:
+                break
+    return out
+
+
+def _refine_lts(sep: _Sep, p0: P4, h: int, nm: NmOptions, floor: float) -> tuple[float, P4]:
+    """Concentration steps with ``vs`` free, until the subset settles."""
+    n = len(sep.a)
+    p = p0
+    order = list(range(n))
+    best: tuple[float, P4] = (math.inf, p0)
+    for _ in range(12):
+        e = sep.residuals(p)
+        order.sort(key=lambda i: abs(e[i]))
+        obj = 0.0
+        for i in order[:h]:
+            obj += e[i] * e[i]
+        if math.isnan(obj) or obj >= best[0] * (1.0 - 1e-10):
+            break
+        best = (obj, p)
+        w = [0.0] * n
+        for i in order[:h]:
+            w[i] = 1.0
+        pn, _ = _vp_minimize(sep, w, _ln(p[3]), 0.05, nm, floor)
+        if not all(math.isfinite(v) for v in pn):
+            break
+        p = pn
+    return best
+
+
+def _lts_sizes(n: int) -> list[int]:
+    def clamp(h: int) -> int:
+        return min(max(h, 5), n)
+
+    return [clamp((n + 4) // 2), clamp(-(-3 * n // 4)), clamp(-(-2 * n // 5))]
+
+
+def _clamp_start(p: P4 | None, a: list[float], fscale: float) -> P4:
+    amin, amax = min(a), max([0.0, *a])
+    if p is None or not all(math.isfinite(v) for v in p):
+        p = [fscale, 1.5 * fscale, 0.0, amax]
+    p = list(p)
+    p[0] = max(p[0], 1e-3 * fscale)
+    p[1] = max(p[1], p[0] * 1.01 + 1e-6 * fscale)
+    p[2] = max(p[2], 1e-6 * fscale / max(amax, 1e-300))
+    p[3] = min(max(p[3], amin * 0.5), amax * 2.0)
+    return p
+
+
+# ---- IRLS and the refit of the kept points (reweight.rs) ---------------------------------
+
+
+class _Cfg:
+    def __init__(self, max_outer: int, tol: float, scale_floor: float, max_evals: int) -> None:
+        self.max_outer, self.tol, self.scale_floor = max_outer, tol, scale_floor
+        self.nm = NmOptions(max_evals, 1e-10, 1e-12, 0)
+        self.nm_loose = NmOptions(max_evals, 1e-10, 1e-7, 0)
+        self.nm_pre = NmOptions(max_evals, 1e-10, 1e-5, 0)
+        self.obj_floor = 1e-6 * scale_floor * scale_floor
+
+
+class _Outcome:
+    def __init__(self, p: P4, residuals: list[float], weights: list[float], scale: float,
+                 iterations: int, converged: bool, evals: int) -> None:
+        self.p, self.residuals, self.weights, self.scale = p, residuals, weights, scale
+        self.iterations, self.converged, self.evals = iterations, converged, evals
+
+
+def _max_rel_change(p: P4, q: P4) -> float:
+    m = 0.0
+    for a, b in zip(p, q):
+        m = max(m, abs(a - b) / max(abs(a), abs(b), 1e-300))
+    return m
+
+
+def _irls_vp(sep: _Sep, p0: P4, weighting: Weighting, cfg: _Cfg, stage: str) -> _Outcome:
+    """IRLS (eqs. 19-24) over the profile; ``stage`` is ``pre``, ``refit`` or ``polish``."""
+    p = p0
+    e = sep.residuals(p)
+
+    def scale_of(e: list[float]) -> float:
+        return max(robust_scale(e), cfg.scale_floor)
+
+    s = scale_of(e)
+    w = weighting.weights(e, s)
+    evals = 1
+    converged = False
+    iterations = 0
+    step = 0.3
+    while iterations < max(cfg.max_outer, 1):
+        iterations += 1
+        nm = cfg.nm_pre if stage == "pre" else cfg.nm_loose
+        pn, ev = _vp_minimize(sep, w, _ln(p[3]), step, nm, cfg.obj_floor)
+        evals += ev
+        dtheta = _max_rel_change(p, pn)
+        d_ln_vs = abs(_ln(pn[3] / p[3]))
+        p = pn
+        e = sep.residuals(p)
+        s = scale_of(e)
+        w_new = weighting.weights(e, s)
+        dw, dw_sum = 0.0, 0.0
+        for a, b in zip(w_new, w):
+            d = abs(a - b)
+            dw, dw_sum = max(dw, d), dw_sum + d
+        dw_mean = dw_sum / max(len(w), 1)
+        w = w_new
+        dw_tol = 1e-2 if stage == "pre" else 1e-3
+        if dw <= dw_tol or dw_mean <= 1e-5 or dtheta <= cfg.tol:
+            converged = True
+            break
+        step = min(max(3.0 * d_ln_vs, 1e-3), 0.1)
+    if stage == "polish":
+        pn, ev = _vp_minimize(sep, w, _ln(p[3]), 1e-3, cfg.nm, cfg.obj_floor)
+        evals += ev
+        p = pn
+        e = sep.residuals(p)
+        s = scale_of(e)
+    return _Outcome(p, e, w, s, iterations, converged, evals)
+
+
+def _refit_kept(sep: _Sep, out: _Outcome, k1: float, cfg: _Cfg) -> None:
+    """Least squares on the kept points, rejections re-checked at ``k1`` times the kept
+    points' scale until the kept set settles."""
+    keep = [1.0 if w > 0.0 else 0.0 for w in out.weights]
+    phi = _exp(-0.5 * k1 * k1) / math.sqrt(2.0 * math.pi)
+    var_factor = 1.0 - 2.0 * k1 * phi / math.erf(k1 / math.sqrt(2.0))
+    for _ in range(5):
+        n_kept = 0.0
+        for k in keep:
+            n_kept += k
+        if n_kept < MIN_POINTS_PER_DIRECTION:
+            return
+        p, ev = _vp_minimize(sep, keep, _ln(out.p[3]), 1e-3, cfg.nm, cfg.obj_floor)
+        out.evals += ev
+        e = sep.residuals(p)
+        ss = 0.0
+        for ei, wi in zip(e, keep):
+            ss += wi * ei * ei
+        s = max(math.sqrt(ss / (n_kept - 4.0) / var_factor), cfg.scale_floor)
+        new_keep = [1.0 if abs(ei) <= k1 * s else 0.0 for ei in e]
+        out.p, out.residuals, out.scale, out.weights = p, e, s, list(keep)
+        if new_keep == keep:
+            return
+        keep = new_keep
+
+
+# ---- covariance (intervals.rs) ----------------------------------------------------------
+
+
+def _inverse4(a: list[list[float]]) -> list[list[float]] | None:
+    """The inverse of a 4x4 matrix by cofactors, as nalgebra's ``try_inverse`` (MESA's
+    unrolled formula; None when the determinant is zero)."""
+    m = [a[k % 4][k // 4] for k in range(16)]  # column-major, as nalgebra stores it
+    c00 = (m[5] * m[10] * m[15] - m[5] * m[11] * m[14] - m[9] * m[6] * m[15]
+           + m[9] * m[7] * m[14] + m[13] * m[6] * m[11] - m[13] * m[7] * m[10])
+    c01 = (-m[4] * m[10] * m[15] + m[4] * m[11] * m[14] + m[8] * m[6] * m[15]
+           - m[8] * m[7] * m[14] - m[12] * m[6] * m[11] + m[12] * m[7] * m[10])
+    c02 = (m[4] * m[9] * m[15] - m[4] * m[11] * m[13] - m[8] * m[5] * m[15]
+           + m[8] * m[7] * m[13] + m[12] * m[5] * m[11] - m[12] * m[7] * m[9])
+    c03 = (-m[4] * m[9] * m[14] + m[4] * m[10] * m[13] + m[8] * m[5] * m[14]
+           - m[8] * m[6] * m[13] - m[12] * m[5] * m[10] + m[12] * m[6] * m[9])
+    det = m[0] * c00 + m[1] * c01 + m[2] * c02 + m[3] * c03
+    if det == 0.0:
+        return None
+    o = [[0.0] * 4 for _ in range(4)]
+    o[0][0], o[0][1], o[0][2], o[0][3] = c00, c01, c02, c03
+    o[1][0] = (-m[1] * m[10] * m[15] + m[1] * m[11] * m[14] + m[9] * m[2] * m[15]
+               - m[9] * m[3] * m[14] - m[13] * m[2] * m[11] + m[13] * m[3] * m[10])
+    o[2][0] = (m[1] * m[6] * m[15] - m[1] * m[7] * m[14] - m[5] * m[2] * m[15]
+               + m[5] * m[3] * m[14] + m[13] * m[2] * m[7] - m[13] * m[3] * m[6])
+    o[3][0] = (-m[1] * m[6] * m[11] + m[1] * m[7] * m[10] + m[5] * m[2] * m[11]
+               - m[5] * m[3] * m[10] - m[9] * m[2] * m[7] + m[9] * m[3] * m[6])
+    o[1][1] = (m[0] * m[10] * m[15] - m[0] * m[11] * m[14] - m[8] * m[2] * m[15]
+               + m[8] * m[3] * m[14] + m[12] * m[2] * m[11] - m[12] * m[3] * m[10])
+    o[2][1] = (-m[0] * m[6] * m[15] + m[0] * m[7] * m[14] + m[4] * m[2] * m[15]
+               - m[4] * m[3] * m[14] - m[12] * m[2] * m[7] + m[12] * m[3] * m[6])
+    o[3][1] = (m[0] * m[6] * m[11] - m[0] * m[7] * m[10] - m[4] * m[2] * m[11]
+               + m[4] * m[3] * m[10] + m[8] * m[2] * m[7] - m[8] * m[3] * m[6])
+    o[1][2] = (-m[0] * m[9] * m[15] + m[0] * m[11] * m[13] + m[8] * m[1] * m[15]
+               - m[8] * m[3] * m[13] - m[12] * m[1] * m[11] + m[12] * m[3] * m[9])
+    o[2][2] = (m[0] * m[5] * m[15] - m[0] * m[7] * m[13] - m[4] * m[1] * m[15]
+               + m[4] * m[3] * m[13] + m[12] * m[1] * m[7] - m[12] * m[3] * m[5])
+    o[3][2] = (-m[0] * m[5] * m[11] + m[0] * m[7] * m[9] + m[4] * m[1] * m[11]
+               - m[4] * m[3] * m[9] - m[8] * m[1] * m[7] + m[8] * m[3] * m[5])
+    o[1][3] = (m[0] * m[9] * m[14] - m[0] * m[10] * m[13] - m[8] * m[1] * m[14]
+               + m[8] * m[2] * m[13] + m[12] * m[1] * m[10] - m[12] * m[2] * m[9])
+    o[2][3] = (-m[0] * m[5] * m[14] + m[0] * m[6] * m[13] + m[4] * m[1] * m[14]
+               - m[4] * m[2] * m[13] - m[12] * m[1] * m[6] + m[12] * m[2] * m[5])
+    o[3][3] = (m[0] * m[5] * m[10] - m[0] * m[6] * m[9] - m[4] * m[1] * m[10]
+               + m[4] * m[2] * m[9] + m[8] * m[1] * m[6] - m[8] * m[2] * m[5])
+    inv_det = 1.0 / det
+    return [[v * inv_det for v in row] for row in o]
+
+
+def _covariance(a: list[float], weights: list[float], residuals: list[float],
+                p: P4) -> tuple[list[float], list[float], float, int, float]:
+    """``sigma^2 (J^T W J)^-1`` of the column-scaled matrix; std errors, covariance,
+    sigma, points used, degrees of freedom (``intervals::covariance``)."""
+    jtwj = [[0.0] * 4 for _ in range(4)]
+    for ai, wi in zip(a, weights):
+        if wi == 0.0:
+            continue
+        r0 = ai / p[3]
+        phi = _exp(-(r0 * r0))
+        r = (1.0 - phi, phi, ai, (p[1] - p[0]) * phi * 2.0 * ai * ai / (p[3] * p[3] * p[3]))
+        for i in range(4):
+            wr = wi * r[i]
+            for j in range(4):
+                jtwj[i][j] += wr * r[j]
+    n_used = sum(1 for w in weights if w > 0.0)
+    dof = n_used - 4.0
+    ssq = 0.0
+    for e, w in zip(residuals, weights):
+        ssq += w * e * e
+    sigma = math.sqrt(ssq / dof) if dof > 0.0 else math.nan
+    d = [math.sqrt(jtwj[k][k]) if jtwj[k][k] >= 0.0 else math.nan for k in range(4)]
+    std_err = [math.nan] * 4
+    cov_out = [math.nan] * 16
+    if all(x > 0.0 and math.isfinite(x) for x in d) and math.isfinite(sigma):
+        dm = [1.0 / x for x in d]
+        inv = _inverse4([[dm[i] * jtwj[i][j] * dm[j] for j in range(4)] for i in range(4)])
+        if inv is not None:
+            s2 = sigma * sigma
+            cov = [[dm[i] * inv[i][j] * dm[j] * s2 for j in range(4)] for i in range(4)]
+            for k in range(4):
+                if cov[k][k] >= 0.0:
+                    std_err[k] = math.sqrt(cov[k][k])
+            if all(math.isfinite(s) for s in std_err):
+                cov_out = [0.5 * (cov[i][j] + cov[j][i]) for i in range(4) for j in range(4)]
+    return std_err, cov_out, sigma, n_used, dof
+
+
+# ---- one direction, both directions (mod.rs) ---------------------------------------------
+
+
+def _fit_direction(a: list[float], y: list[float], sign: float, indices: list[int],
+                   weighting: Weighting, max_iter: int, scale_floor: float,
+                   notes: list[str], label: str) -> dict[str, Any]:
+    fscale = max(median([abs(v) for v in y]), 1e-12)
+    sep = _Sep(a, y, fscale)
+    floor = max(scale_floor, 1e-6 * fscale)
+    cfg = _Cfg(max_iter, 1e-7, floor, 4000)
+    reject_at = weighting.rejects_at
+
+    def path(p0: P4, pre: Weighting | None) -> _Outcome:
+        evals = 0
+        if pre is not None:
+            o = _irls_vp(sep, p0, pre, cfg, "pre")
+            p0, evals = o.p, o.evals
+        refit = reject_at is not None
+        out = _irls_vp(sep, p0, weighting, cfg, "refit" if refit else "polish")
+        out.evals += evals
+        if reject_at is not None:
+            _refit_kept(sep, out, max(reject_at, REFIT_REJECT_MIN), cfg)
+        return out
+
+    huber_start = _clamp_start(_start_values_huber(sep), a, fscale)
+    if reject_at is not None:
+        # four starts as in MM-estimation: a Huber pass from the Huber grid, a Tukey pass
+        # from least trimmed squares on each subset size; the smallest Tukey loss wins
+        paths = [path(huber_start, Weighting.huber())]
+        for h in _lts_sizes(len(a)):
+            refined = [_refine_lts(sep, _clamp_start(p0, a, fscale), h, cfg.nm_pre,
+                                   cfg.obj_floor) for p0 in _start_values_lts(sep, h)]
+            refined = [r for r in refined if math.isfinite(r[0])]
+            refined.sort(key=lambda r: r[0])
+            for _, p in refined[:1]:
+                paths.append(path(_clamp_start(p, a, fscale), Weighting.tukey()))
+        s = math.inf
+        for o in paths:
+            s = min(s, robust_scale(o.residuals))
+        s = max(s, floor)
+        c = 4.685
+
+        def rho(o: _Outcome) -> float:
+            total = 0.0
+            for e in o.residuals:
+                u = min(abs(e / (c * s)), 1.0)
+                q = 1.0 - u * u
+                total += 1.0 - q * q * q
+            return total
+
+        evals = sum(o.evals for o in paths)
+        out = min(paths, key=rho)
+        out.evals = evals
+    else:
+        out = path(huber_start, None)
+    if not all(math.isfinite(v) for v in out.p):
+        raise DataError(
+            f"data: {label} direction: the Stribeck curve could not be evaluated at the "
+            "start values; check the data for extreme values")
+    p = out.p
+    std_err, cov, sigma, n_used, dof = _covariance(a, out.weights, out.residuals, p)
+    if any(math.isnan(s) for s in std_err):
+        notes.append(
+            f"{label} direction: standard errors unavailable ({n_used} points kept for 4 "
+            "parameters, or a singular Jacobian); add speeds around the Stribeck velocity")
+    tq = t_quantile_975(dof)
+    for k, name in enumerate(STATIC_PARAM_NAMES):
+        rel = _div(std_err[k], p[k])
+        if rel > 0.25:
+            notes.append(
+                f"{label} direction: {name} is poorly determined (standard error "
+                f"{rel * 100.0:.0f} % of the estimate); add constant-velocity points where "
+                "it acts (around vs for fs and vs, at high speed for sigma2)")
+    if not out.converged:
+        notes.append(f"{label} direction: IRLS stopped at the iteration limit "
+                     f"({out.iterations}) before the weights settled")
+    return {
+        "fc": p[0], "fs": p[1], "sigma2": p[2], "vs": p[3],
+        "std_err": std_err, "cov": cov,
+        "ci_low": [v - tq * s for v, s in zip(p, std_err)],
+        "ci_high": [v + tq * s for v, s in zip(p, std_err)],
+        "indices": indices,
+        "weights": np.array(out.weights, dtype=np.float64),
+        "residuals": np.array([sign * e for e in out.residuals], dtype=np.float64),
+        "scale": out.scale, "sigma": sigma, "iterations": out.iterations,
+        "converged": out.converged, "evaluations": out.evals,
+    }
+
+
+def _as_points(name: str, a: Any) -> np.ndarray:
+    """The facade's conversion (``_native._array``), written out here."""
+    try:
+        arr = np.ascontiguousarray(a, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise InputError.at(name, f"must be an array of numbers ({e})") from None
+    if arr.ndim != 1:
+        raise InputError.at(name, f"must be a 1-D array, got shape {arr.shape}")
+    return arr
+
+
+def _check_finite(name: str, a: list[float]) -> None:
+    for k, x in enumerate(a):
+        if not math.isfinite(x):
+            raise InputError.at(
+                name, f"element {k} is {_fmt_f64(x)} : remove or interpolate non-finite samples")
+
+
+def _usize(value: Any) -> int:
+    """``int(value)`` as the binding takes a ``usize`` (negative: OverflowError)."""
+    n = int(value)
+    if n < 0:
+        raise OverflowError("can't convert negative int to unsigned")
+    return n
+
+
+def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
+               scale_floor: float = 0.0) -> StaticFit:
+    """Robust Stribeck fit of steady-state points, per direction (NumPy twin of
+    :func:`lugre.fit_static`; same parameters, result, warnings and errors).
+
+    Parameters
+    ----------
+    v : array_like
+        Constant velocities [m/s]; zero speeds are ignored (and counted).
+    F : array_like
+        Steady-state forces [N] (negative for ``v < 0``).
+    weighting : {"igg", "huber", "tukey", "none"}
+        Robust weight function; ``"none"`` is plain least squares.
+    max_iter : int
+        IRLS iterations at most.
+    scale_floor : float
+        Lower bound of the residual scale [N] (e.g. the force resolution).
+
+    Returns
+    -------
+    StaticFit
+
+    Raises
+    ------
+    DataError
+        Fewer than 5 points in a direction, one direction only, only zero speeds.
+    InputError
+        NaN or inf, lengths differ, empty input, unknown weighting.
+    ParameterError
+        ``scale_floor`` negative or not finite.
+    """
+    va = _as_points("v", v).tolist()
+    fa = _as_points("F", F).tolist()
+    wname = str(weighting)
+    iters = _usize(max_iter)
+    floor = float(scale_floor)
+    wt = Weighting.from_name(wname)
+    # the core's checks in the core's order (static_fit/mod.rs, fit_static)
+    if len(fa) != len(va):
+        raise InputError.at("f", f"has {len(fa)} samples but v has {len(va)}: give arrays "
+                            "of the same length")
+    if not va:
+        raise InputError.at("v", "is empty: give steady-state (v, F) points")
+    _check_finite("v", va)
+    _check_finite("f", fa)
+    if not (floor >= 0.0 and math.isfinite(floor)):
+        raise ParameterError.invalid("scale_floor", floor, "must be finite and zero or greater")
+    n_zero = sum(1 for x in va if x == 0.0)
+    if n_zero == len(va):
+        raise DataError("data: every speed is zero: the Stribeck curve needs "
+                        "constant-velocity points in both directions")
+
+    def split(pos: bool) -> tuple[list[float], list[float], list[int]]:
+        a, y, idx = [], [], []
+        for k, (vk, fk) in enumerate(zip(va, fa)):
+            if (pos and vk > 0.0) or (not pos and vk < 0.0):
+                a.append(abs(vk))
+                y.append(fk if pos else -fk)
+                idx.append(k)
+        return a, y, idx
+
+    ap, yp, ip = split(True)
+    an, yn, in_ = split(False)
+    if not ap or not an:
+        have, miss = ("v < 0", "v > 0") if not ap else ("v > 0", "v < 0")
+        raise DataError(f"data: only one direction of motion in the data ({have}): add "
+                        f"constant-velocity points with {miss}, each direction has its own "
+                        "friction parameters")
+    for label, a in (("v > 0", ap), ("v < 0", an)):
+        if len(a) < MIN_POINTS_PER_DIRECTION:
+            raise DataError(f"data: {len(a)} points with {label}: at least "
+                            f"{MIN_POINTS_PER_DIRECTION} are needed for the 4 Stribeck "
+                            "parameters; add constant-velocity runs in that direction")
+    notes: list[str] = []
+    pos = _fit_direction(ap, yp, 1.0, ip, wt, iters, floor, notes, "positive")
+    neg = _fit_direction(an, yn, -1.0, in_, wt, iters, floor, notes, "negative")
+    weights = np.zeros(len(va))
+    for d in (pos, neg):
+        weights[d["indices"]] = d["weights"]
+    rejected = [k for k in range(len(va)) if va[k] != 0.0 and weights[k] == 0.0]
+    fit = StaticFit(
+        positive=DirectionFit._from_core(pos),
+        negative=DirectionFit._from_core(neg),
+        weights=weights,
+        rejected=rejected,
+        n_zero_speed=n_zero,
+        weighting=wt.name,
+        notes=notes,
+    )
+    if not fit.converged:
+        warnings.warn("static fit: IRLS reached its iteration limit before the weights "
+                      "settled; check the rejected points", ConvergenceWarning, stacklevel=2)
+    return fit
