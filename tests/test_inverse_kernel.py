@@ -182,7 +182,7 @@ def test_diagnose_same_on_both_backends():
     rec, model, _ = concealed("cogging", duration=3.0)
     kw = {"closed_loop": False, "candidates": ["cogging", "offset", "spring", "drag"]}
     a = lugre.diagnose(rec, model, **kw)
-    b = lugre.diagnose(rec, model, backend="reference", **kw)
+    b = reference.diagnose(rec, model, **kw)
     assert [f.effect for f in a.findings] == [f.effect for f in b.findings] == ["cogging"]
     pa, pb = a.findings[0].parameters, b.findings[0].parameters
     for k in pa:
@@ -200,3 +200,15 @@ def test_residuals_batch_as_one_by_one(pair, backend):
     for j, m in enumerate(models):
         np.testing.assert_array_equal(batch[:, j], sig.kernel.residual(m))
     assert sig.kernel.residuals([]).shape == (len(sig), 0)
+
+
+def test_fit_inverse_dynamics_same_on_both_backends():
+    rec, _, truth = concealed("none", duration=4.0)
+    a = lugre.fit_inverse_dynamics(rec, force_constant=truth.force_constant)
+    b = reference.fit_inverse_dynamics(rec, force_constant=truth.force_constant)
+    da, db = a.to_dict(), b.to_dict()
+    for side in ("positive", "negative"):
+        for k in ("fc", "fs", "sigma2", "vs"):
+            assert da["friction"][side][k] == pytest.approx(db["friction"][side][k],
+                                                            rel=1e-9)
+    assert da["axis"]["mass"] == pytest.approx(db["axis"]["mass"], rel=1e-9)

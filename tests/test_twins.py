@@ -43,8 +43,6 @@ def assert_same_result(a, b):
 #: a twin is added, its name leaves this list (the test below fails until it does).
 NOT_IN_REFERENCE = {
     # computations still to be twinned
-    "diagnose": "waits for the Rust residual kernel, then gets its NumPy twin",
-    "fit_inverse_dynamics": "waits for the Rust residual kernel, then gets its NumPy twin",
     "steady_state_points": "plateau detection (src/estimate/plateaus.rs): not twinned yet",
     # pure Python on both sides already (no core to check): nothing to twin
     "design_static": "pure Python (lugre.design), over a StaticFit",

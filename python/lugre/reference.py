@@ -15,7 +15,9 @@ step) and meant for checking the core and for reading. Never calls :mod:`lugre._
   :class:`DynamicFit`;
 - :func:`evaluate` runs the diagnosis's preparation of the record (SciPy filters) with
   the residual from :class:`InverseRecord`, the NumPy twin of the inverse-dynamics
-  kernel (``_reference_inverse``);
+  kernel (``_reference_inverse``); :func:`diagnose` and :func:`fit_inverse_dynamics`
+  (``_reference_diagnose``) share the diagnosis's orchestration and take every numeric
+  kernel from here;
 - :func:`load_model` and :func:`save_model` are the facade's own (Python) functions.
 
 Examples
@@ -54,6 +56,7 @@ from .model import (
 )
 
 if TYPE_CHECKING:  # pragma: no cover
+    from ._reference_diagnose import diagnose, fit_inverse_dynamics
     from ._reference_dynamic import DynamicFit, fit_dynamic
     from ._reference_evaluate import evaluate
     from ._reference_static import StaticFit, fit_static
@@ -64,8 +67,10 @@ __all__ = [
     "InverseRecord",
     "SimResult",
     "StaticFit",
+    "diagnose",
     "evaluate",
     "fit_dynamic",
+    "fit_inverse_dynamics",
     "fit_static",
     "friction_force",
     "load_coupling",
@@ -85,6 +90,8 @@ _LAZY = {
     "DynamicFit": "._reference_dynamic",
     "fit_dynamic": "._reference_dynamic",
     "evaluate": "._reference_evaluate",
+    "diagnose": "._reference_diagnose",
+    "fit_inverse_dynamics": "._reference_diagnose",
 }
 
 

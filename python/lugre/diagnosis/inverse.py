@@ -28,6 +28,7 @@ def fit_inverse_dynamics(
     sigma0: float | None = None,
     cutoff_hz: float | None = None,
     controller: dict[str, Any] | None = None,
+    backend: str = "core",
 ) -> Model:
     """Fit a LuGre axis model by robust least squares on the inverse dynamics.
 
@@ -52,6 +53,8 @@ def fit_inverse_dynamics(
         Low-pass cut-off (default ``fs/25``).
     controller : dict, optional
         Controller section to put in the model.
+    backend : {"core", "reference"}, default "core"
+        The compiled inverse-dynamics kernel or its NumPy twin.
 
     Returns
     -------
@@ -62,7 +65,7 @@ def fit_inverse_dynamics(
     proto = Model.paper().replace(
         axis={"mass": 1.0, "force_constant": float(force_constant)}, effects=[],
         controller=None)
-    sig = R.prepare(rec, proto, cutoff_hz=cutoff_hz)
+    sig = R.prepare(rec, proto, cutoff_hz=cutoff_hz, backend=backend)
     v = sig.v
     m = sig.mask
     vmax = float(np.max(np.abs(sig.vf[m])))
