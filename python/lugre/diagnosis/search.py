@@ -20,6 +20,7 @@ sample count nor a white-noise information criterion measures the evidence. Inst
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -64,15 +65,18 @@ class Evaluation:
     jack: np.ndarray | None = None
     r: np.ndarray | None = None
     J: np.ndarray | None = None
-    X: np.ndarray | None = None
+    X: list[np.ndarray] = field(default_factory=list)
 
     @property
     def fitted(self) -> np.ndarray:
         """The fitted change of the residual, ``J @ beta_base + X @ beta_effects`` [N]."""
-        assert self.J is not None and self.X is not None
-        q = self.J.shape[1]
-        out = self.J @ self.beta[:q]
-        return out + self.X @ self.beta[q:] if self.X.shape[1] else out
+        assert self.J is not None
+        j = self.J.shape[1]
+        out = self.J @ self.beta[:j]
+        for x in self.X:
+            out = out + x @ self.beta[j:j + x.shape[1]]
+            j += x.shape[1]
+        return out
 
     @property
     def resid(self) -> np.ndarray:
@@ -116,6 +120,12 @@ class Scorer:
         idx = idx[:nb * self.K]
         self.idx = idx
         self._nb = nb
+        # the used samples as one slice when they are contiguous (the usual mask: the
+        # filter's edges left out): blocks of a column are then views, not copies
+        self._span = (slice(int(idx[0]), int(idx[-1]) + 1)
+                      if idx.size and idx[-1] - idx[0] == idx.size - 1 else None)
+        self._products: dict[int, tuple[Any, tuple[np.ndarray, ...]]] = {}
+        self._cross: dict[tuple[int, int], tuple[Any, Any, np.ndarray]] = {}
         edges = np.arange(self.K + 1) * nb
         self.blocks = [slice(edges[k], edges[k + 1]) for k in range(self.K)]
         self.center = np.zeros(J.shape[1]) if center is None else np.asarray(center, float)
@@ -130,6 +140,34 @@ class Scorer:
     def _stack(self, a: np.ndarray) -> np.ndarray:
         """``(n, c)`` samples as ``(K, n/K, c)`` blocks."""
         return a.reshape(self.K, self._nb, a.shape[1])
+
+    def _blocks_of(self, X: np.ndarray) -> np.ndarray:
+        """The used samples of the columns ``X`` as ``(K, n/K, p)`` blocks."""
+        if self._span is not None:
+            return self._stack(np.ascontiguousarray(X[self._span]))
+        return self._stack(X[self.idx])
+
+    def _term_products(self, X: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Per-block products of a term's columns with the base columns, themselves and
+        the residual, computed once per column array (the search scores the same
+        columns again at every step of the selection)."""
+        hit = self._products.get(id(X))
+        if hit is not None and hit[0]() is X:
+            return hit[1]
+        Xm = self._blocks_of(X)
+        out = (self._gram(Xm, self._Jm), self._gram(Xm, Xm), self._gram(Xm, self._rm)[:, :, 0])
+        self._products[id(X)] = (weakref.ref(X), out)  # (a weak key: X may be dropped)
+        return out
+
+    def _cross_products(self, X1: np.ndarray, X2: np.ndarray) -> np.ndarray:
+        """Per-block ``X1.T @ X2`` of two terms' columns (kept for the pair)."""
+        key = (id(X1), id(X2))
+        hit = self._cross.get(key)
+        if hit is not None and hit[0]() is X1 and hit[1]() is X2:
+            return hit[2]
+        g = self._gram(self._blocks_of(X1), self._blocks_of(X2))
+        self._cross[key] = (weakref.ref(X1), weakref.ref(X2), g)
+        return g
 
     @staticmethod
     def _gram(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -149,25 +187,33 @@ class Scorer:
         Evaluation
         """
         q = self.J.shape[1]
-        X = (np.column_stack([t.X for t in terms]) if terms
-             else np.zeros((self.J.shape[0], 0)))
+        Xs = [t.X for t in terms]
         tols = [self.tol]
         for t in terms:  # effect priors (absolute, in coefficient units); None: flat
             tols.append(np.full(t.X.shape[1], np.inf) if t.prior is None else t.prior)
         ptol = np.concatenate(tols)
-        p = X.shape[1]
+        p = sum(x.shape[1] for x in Xs)
         # per-block Gram matrices, raw, then scaled by the columns' rms
         G_b = np.empty((self.K, q + p, q + p))
         G_b[:, :q, :q] = self._GJJ
         h_b = np.empty((self.K, q + p))
         h_b[:, :q] = self._hJ
-        if p:
-            Xm = self._stack(X[self.idx])
-            GXJ = self._gram(Xm, self._Jm)
-            G_b[:, q:, :q] = GXJ
-            G_b[:, :q, q:] = GXJ.transpose(0, 2, 1)
-            G_b[:, q:, q:] = self._gram(Xm, Xm)
-            h_b[:, q:] = self._gram(Xm, self._rm)[:, :, 0]
+        offs = []
+        o = q
+        for i, x in enumerate(Xs):
+            pi = x.shape[1]
+            GXJ, GXX, GXr = self._term_products(x)
+            G_b[:, o:o + pi, :q] = GXJ
+            G_b[:, :q, o:o + pi] = GXJ.transpose(0, 2, 1)
+            G_b[:, o:o + pi, o:o + pi] = GXX
+            h_b[:, o:o + pi] = GXr
+            for j in range(i):
+                oj, pj = offs[j], Xs[j].shape[1]
+                C = self._cross_products(Xs[j], x)
+                G_b[:, oj:oj + pj, o:o + pi] = C
+                G_b[:, o:o + pi, oj:oj + pj] = C.transpose(0, 2, 1)
+            offs.append(o)
+            o += pi
         rr_b = self._rr
         diag = np.einsum("kii->i", G_b)
         sc = np.sqrt(diag / self.idx.size)
@@ -206,7 +252,7 @@ class Scorer:
         beta = b / sc
         score = float(sse_b.sum() / self.s2 + prior)
         return Evaluation(score=score, sse_b=sse_b, prior=prior, beta=beta, sse=sse,
-                          splits=self.blocks, jack=jack, r=self.r, J=self.J, X=X)
+                          splits=self.blocks, jack=jack, r=self.r, J=self.J, X=Xs)
 
 
 def make_term(c: Candidate, h: Any, ctx: Context) -> Term:
