@@ -51,6 +51,31 @@ def test_static_points_with_gross_errors():
     assert worst_ls > 0.05
 
 
+def test_static_direction_with_half_gross_errors():
+    """Half the v > 0 points scaled up by 10-40 % (one-sided: they do not cancel, and the
+    MAD of any fit is as large as the gross errors): the fit keeps the trimmed fit's
+    high-breakdown scale and chooses among its starts by a mixture likelihood, so it
+    often finds the clean curve and rejects exactly the gross errors (22 of 40 data sets
+    when measured; the former MAD-scaled IRLS, 0 of 40)."""
+    truth = lugre.Model.paper()
+    a = np.geomspace(2e-4, 0.4, 24)
+    v = np.concatenate([a, -a])
+    good = 0
+    for seed in range(40):
+        rng = np.random.default_rng(seed)
+        F = lugre.stribeck(v, truth) + 0.3 * rng.standard_normal(v.size)
+        out = np.zeros(v.size, bool)
+        out[rng.choice(24, 12, replace=False)] = True
+        F[out] *= 1 + rng.uniform(0.1, 0.4, 12)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            fit = lugre.fit_static(v, F)
+        err = max(abs(fit.positive.params[k] / truth.positive[k] - 1)
+                  for k in ("fc", "fs", "sigma2", "vs"))
+        good += err < 0.05 and sorted(fit.rejected) == list(np.flatnonzero(out))
+    assert good >= 14, good
+
+
 @needs_static
 def test_static_from_raw_plateaus():
     """The raw plateau record: plateaus found, creeping ones skipped and said so, fc and
