@@ -457,8 +457,10 @@ def _carry_static(static_fit: StaticFit, m: Model, est: np.ndarray, lo: np.ndarr
                 f" (+-{100 * rel[j]:.0f} %), {100 * share:.0f} % of its variance from the "
                 f"static parameters, above all {causes}")
         if was and not identifiable[j]:
-            text += (f"; NOT determined: this record cannot separate {k} from the static "
-                     f"step's errors in {' and '.join(labels[c] for c in big)}. Measure it "
+            text += (f"; NOT determined: {k} acts where the axis breaks away, where the "
+                     "static curve's hump fs - fc and its width vs set the force too, and "
+                     f"this record cannot separate {k} from the static step's errors there "
+                     f"(above all {' and '.join(labels[c] for c in big)}). Measure it "
                      "directly (a presliding record at standstill, lugre.presliding) or "
                      "tighten the static step where those parameters act (lugre "
                      "design-static)")
