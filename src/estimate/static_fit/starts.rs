@@ -339,9 +339,10 @@ const LTS_REWEIGHT_CUT: f64 = 2.5;
 /// High-breakdown residual scale of a least-trimmed-squares fit (the scale an
 /// MM-estimate holds fixed in its M-step, Yohai 1987; reweighted as in Rousseeuw and
 /// Van Driessen 2006). The raw scale is the root mean of the `h` smallest squared
-/// residuals, made consistent for Gaussian errors (the central fraction `h/n`); the
-/// points within [`LTS_REWEIGHT_CUT`] raw scales then give the scale on `kept - 4`
-/// degrees of freedom, consistent for the truncation. Unlike the MAD of all residuals,
+/// residuals on `h - 4` degrees of freedom (the fit brought them down), made consistent
+/// for Gaussian errors (the central fraction `h/n`); twice, the points within
+/// [`LTS_REWEIGHT_CUT`] scales then give the scale on `kept - 4` degrees of freedom,
+/// consistent for the truncation. Unlike the MAD of all residuals,
 /// it does not grow with the share of gross errors as long as the `h` points are clean,
 /// also when a direction holds half or more gross errors.
 pub(super) fn lts_scale(e: &[f64], h: usize) -> f64 {
