@@ -361,6 +361,7 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     print(f"inverse dynamics (robust least squares, static friction curve): force nrmse "
           f"{100 * before:.2f} %")
     after = None
+    dg = None
     if not args.no_refine:
         # refine every base parameter with the bristle state simulated along the measured
         # velocity (the diagnosis's base re-estimation, with no extra physics)
@@ -392,6 +393,20 @@ def _cmd_fit(args: argparse.Namespace) -> int:
 
     for note in stribeck_determinacy(rec, model):
         print(f"note: {note}")
+    # sigma0 and sigma1 act in presliding: the refinement frees them only when the record
+    # shows it (held-out test); otherwise they keep the inverse-dynamics guesses
+    base = dg.base if dg is not None and model is not first else {}
+    for k in ("sigma0", "sigma1"):
+        status = base.get(k, {}).get("status", "")
+        if status == "refitted":
+            continue
+        print(f"note: {k} = {getattr(model, k):.4g} {'N/m' if k == 'sigma0' else 'N s/m'} is "
+              "NOT determined by this record (a start guess, held: the record does not show "
+              "the presliding regime at its sampling rate and resolution). Would determine "
+              "it: a presliding record at standstill, an open-loop force sweep below "
+              "break-away (lugre.presliding), or a closed-loop stick-slip record with the "
+              "static sets from constant-velocity runs (lugre fit-static, then lugre "
+              "fit-dynamic)")
     page = None
     if args.html:
         from .html import fit_page

@@ -325,12 +325,155 @@ def _check_stick_slip(rec: Recording) -> None:
         )
 
 
+def _static_cov(static_fit: StaticFit) -> dict[str, tuple[np.ndarray, int]]:
+    """Each direction's joint covariance of ``fc, fs, sigma2, vs`` (diagonal from the
+    standard errors when the full one is unavailable) and its degrees of freedom."""
+    out = {}
+    for d in ("positive", "negative"):
+        df = getattr(static_fit, d)
+        C = np.asarray(df.cov, float)
+        if not np.all(np.isfinite(C)):
+            C = np.diag([df.std_err[k] ** 2 if np.isfinite(df.std_err[k]) else 0.0
+                         for k in STATIC_NAMES])
+        out[d] = (0.5 * (C + C.T), max(int(np.sum(np.asarray(df.weights) > 0)) - 4, 1))
+    return out
+
+
+def _static_draws(cov: dict[str, tuple[np.ndarray, int]], n: int,
+                  rng: np.random.Generator) -> dict[str, np.ndarray]:
+    """``n`` draws of each direction's static errors from its joint covariance, as a
+    multivariate t on the fit's degrees of freedom (the covariance rests on an
+    estimated residual scale): ``{direction: (n, 4) array}``."""
+    out = {}
+    for d, (C, dof) in cov.items():
+        lam, U = np.linalg.eigh(C)
+        root = U * np.sqrt(np.clip(lam, 0.0, None))
+        z = rng.standard_normal((n, 4)) @ root.T
+        out[d] = z * np.sqrt(dof / rng.chisquare(dof, size=n))[:, None]
+    return out
+
+
+def _carry_static(static_fit: StaticFit, m: Model, est: np.ndarray, lo: np.ndarray,
+                  hi: np.ndarray, identifiable: list[bool], notes: list[str], n_draws: int,
+                  refit: Any) -> tuple[np.ndarray, np.ndarray, list[bool], list[str]]:
+    """The static step's uncertainty in the intervals of ``ln sigma0, ln sigma1``.
+
+    Refits at static sets drawn from the static step's joint covariance (both
+    directions at once, fixed-seed generator so a fit is reproducible), then, per
+    parameter, two refits at the ends of the static step's joint 95 % confidence region
+    (``delta^T C^-1 delta = p F(p, dof)``) along the direction that moves it most (the
+    gradient from a least-squares regression of the draws' refits): the interval holds
+    the estimate and every refit, widened by the record's own noise half-width. It so
+    holds the parameter for every static set in that region (a projection interval),
+    which a parameter that depends far from linearly on the static sets needs: a
+    static error a few standard errors along that one direction (as likely as a
+    marginal 95 % miss of one static parameter) is still inside."""
+    from scipy.stats import f as f_dist
+
+    names = ("sigma0", "sigma1")
+    sd_noise = (np.log(hi) - np.log(lo)) / (2 * 1.96)
+    cov = _static_cov(static_fit)
+    draws = _static_draws(cov, n_draws, np.random.default_rng(20240517))
+    dirs = tuple(cov)
+    base = np.concatenate([[getattr(m, d)[k] for k in STATIC_NAMES] for d in dirs])
+    labels = [f"{k} ({d})" for d in dirs for k in STATIC_NAMES]
+    C_all = np.zeros((8, 8))
+    for i, d in enumerate(dirs):
+        C_all[4 * i:4 * i + 4, 4 * i:4 * i + 4] = cov[d][0]
+    sd_static = np.sqrt(np.diag(C_all))
+    n_free = int(np.sum(sd_static > 0))
+    dof = min(c[1] for c in cov.values())
+
+    def at(delta: np.ndarray) -> np.ndarray | None:
+        sets = {}
+        for i, d in enumerate(dirs):
+            b = base[4 * i:4 * i + 4]
+            p = np.maximum(b + delta[4 * i:4 * i + 4], 1e-6 * np.abs(b))
+            p[1] = max(p[1], p[0])          # fs >= fc
+            sets[d] = dict(zip(STATIC_NAMES, map(float, p)))
+        try:
+            rr = refit(m.with_friction(**sets))
+        except DataError:
+            return None
+        y = np.log([rr["sigma0"], rr["sigma1"]]) - np.log(est)
+        return y if np.all(np.isfinite(y)) else None
+
+    ys, xs = [], []
+    for i in range(n_draws):
+        delta = np.concatenate([draws[d][i] for d in dirs])
+        y = at(delta)
+        if y is not None:
+            ys.append(y)
+            xs.append(delta)
+    if len(ys) < 0.9 * n_draws or n_free == 0:
+        if n_free == 0:
+            return lo, hi, identifiable, notes
+        notes.append(f"only {len(ys)} of {n_draws} refits at static sets drawn from the "
+                     "static step's covariance succeeded: the intervals do not carry the "
+                     "static uncertainty and are reported unbounded")
+        return (np.zeros(2), np.full(2, np.inf), [False, False], notes)
+    Y, X = np.array(ys), np.array(xs)
+    keep = sd_static > 0
+    Xs = (X[:, keep] - X[:, keep].mean(axis=0)) / sd_static[keep]
+    coef = np.zeros((8, 2))
+    coef[keep] = np.linalg.lstsq(np.column_stack([np.ones(len(Y)), Xs]), Y,
+                                 rcond=None)[0][1:]
+    radius = float(np.sqrt(n_free * f_dist.ppf(0.95, n_free, dof)))
+    ends: list[list[float]] = [[], []]
+    for j in range(2):
+        g = np.zeros(8)
+        g[keep] = coef[keep, j] / sd_static[keep]
+        gcg = float(g @ C_all @ g)
+        if not gcg > 0:
+            continue
+        step = radius * (C_all @ g) / np.sqrt(gcg)
+        for sgn in (1.0, -1.0):
+            y = at(sgn * step)
+            if y is not None:
+                ends[j].append(float(y[j]))
+    h = 1.96 * sd_noise
+    low = np.array([min([0.0, *Y[:, j], *ends[j]]) for j in range(2)])
+    high = np.array([max([0.0, *Y[:, j], *ends[j]]) for j in range(2)])
+    lo = est * np.exp(low - h)
+    hi = est * np.exp(high + h)
+    rel = (hi - lo) / (2 * est)
+    identifiable = list(identifiable)
+    for j, k in enumerate(names):
+        var_static = float(np.var(Y[:, j]))
+        share = var_static / (var_static + sd_noise[j] ** 2)
+        was = identifiable[j]
+        notes = [n for n in notes if not n.startswith(f"{k} = ")]
+        identifiable[j] = bool(identifiable[j] and rel[j] <= 0.25)
+        big = sorted(range(8), key=lambda c: -abs(coef[c, j]))[:2]
+        causes = " and ".join(f"{labels[c]} ({100 * np.expm1(abs(coef[c, j])):.2g} % per "
+                              "standard deviation)" for c in big)
+        text = (f"{k}: refits at {len(Y)} static sets drawn from the static step's joint "
+                f"covariance give {est[j] * np.exp(Y[:, j].min()):.5g} to "
+                f"{est[j] * np.exp(Y[:, j].max()):.5g}"
+                + (f", at the ends of its 95 % confidence region along the direction that "
+                   f"moves {k} most {' and '.join(f'{est[j] * np.exp(e):.5g}' for e in ends[j])}"
+                   if ends[j] else "")
+                + f"; with the record's noise the 95 % interval is [{lo[j]:.5g}, {hi[j]:.5g}]"
+                f" (+-{100 * rel[j]:.0f} %), {100 * share:.0f} % of its variance from the "
+                f"static parameters, above all {causes}")
+        if was and not identifiable[j]:
+            text += (f"; NOT determined: {k} acts where the axis breaks away, where the "
+                     "static curve's hump fs - fc and its width vs set the force too, and "
+                     f"this record cannot separate {k} from the static step's errors there "
+                     f"(above all {' and '.join(labels[c] for c in big)}). Measure it "
+                     "directly (a presliding record at standstill, lugre.presliding) or "
+                     "tighten the static step where those parameters act (lugre "
+                     "design-static)")
+        notes.append(text)
+    return lo, hi, identifiable, notes
+
+
 def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str = "igg",
                 c1: float = 1.0, c2: float = 0.0, sigma0_start: float | None = None,
                 sigma1_start: float | None = None, grid: bool = True, max_iter: int = 20,
                 scale_floor: float = 0.0, substeps: int = 1, integrator: str = "exact",
                 columns: dict[str, str] | None = None,
-                static_fit: StaticFit | None = None) -> DynamicFit:
+                static_fit: StaticFit | None = None, static_draws: int = 39) -> DynamicFit:
     """Estimate sigma0 and sigma1 from a closed-loop record (seed paper, eq. 18).
 
     The model's controller is simulated on the record's ``x_ref`` with the static sets
@@ -357,13 +500,20 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
         Column mapping when ``recording`` is a path.
     static_fit : StaticFit, optional
         The static step whose sets the model holds. Its uncertainty is carried into the
-        intervals of sigma0 and sigma1: per direction, refits with the static set moved
-        by one standard deviation either way along each principal axis of its joint
-        covariance (sigma points), which give the variance and the mean shift of the
-        estimates that the static errors cause (second order). On the paper's axis the
+        intervals of sigma0 and sigma1 by refits at static sets drawn from its joint
+        covariance (per direction, a multivariate t on the static fit's degrees of
+        freedom) and at the two ends of its joint 95 % confidence region along the
+        direction that moves each parameter most: the interval holds every refit,
+        widened by the record's own noise interval, so it holds the parameter for every
+        static set in that region. No linearisation is used: on the paper's axis the
         stick-slip estimate of sigma1 depends far from linearly on the break-away
-        parameters (fs, vs), so even this interval can miss; a presliding record
-        (:mod:`lugre.presliding`) determines sigma1 directly.
+        parameters (fs - fc, vs). A presliding record (:mod:`lugre.presliding`)
+        determines sigma1 directly.
+    static_draws : int
+        Static sets drawn when ``static_fit`` is given (at least 5; each is one refit,
+        plus four at the ends of the confidence region; the direction to those ends is
+        regressed on the draws' refits, 8 static parameters, so fewer than about 20
+        draws leave it rough).
 
     Warns
     -----
@@ -375,6 +525,11 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
     if rec.x_ref is None:
         raise InputError.at("x_ref", f"{rec.source or 'the recording'} has no x_ref column: "
                             "the dynamic fit simulates the closed loop on the reference")
+    if static_fit is not None and not (isinstance(static_draws, (int, np.integer))
+                                       and static_draws >= 5):
+        raise InputError.at("static_draws", f"is {static_draws!r}: give a whole number of at "
+                            "least 5")
+
     def run(mm: Model, s0: float | None, s1: float | None, use_grid: bool) -> dict[str, Any]:
         return _core.fit_dynamic_record(
             mm._core_model(), rec.t, rec.x_ref, rec.x, str(weighting), float(c1),
@@ -389,77 +544,9 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
     notes = list(r["notes"])
     identifiable = [bool(b) for b in r["identifiable"]]
     if static_fit is not None:
-        # delta method on ln(sigma): noise part from the core's interval, static part
-        # from refits with each static parameter moved by one standard error
-        var = ((np.log(hi) - np.log(lo)) / (2 * 1.96)) ** 2
-        # the static step's joint covariance carried by sigma points: for each
-        # direction, refits with the static set moved by +-1 standard deviation along
-        # each principal axis of its covariance (fs and vs errors are strongly
-        # correlated). Half the difference of a pair is the linear term, half the sum
-        # (less twice the centre) the curvature: the variance is the sum of the squared
-        # linear terms, and the curvature terms add up to the mean shift of ln sigma
-        # that the static errors cause (second-order delta method), which moves the
-        # interval (1 % in fs moves sigma1 by about 2x, far from linear).
-        static_var = np.zeros(2)
-        static_bias = np.zeros(2)
-        contrib: dict[str, np.ndarray] = {}
-        for d in ("positive", "negative"):
-            df = getattr(static_fit, d)
-            C = np.asarray(df.cov, float)
-            if not np.all(np.isfinite(C)):
-                C = np.diag([df.std_err[k] ** 2 if np.isfinite(df.std_err[k]) else 0.0
-                             for k in STATIC_NAMES])
-            lam, U = np.linalg.eigh(0.5 * (C + C.T))
-            base = np.array([getattr(m, d)[k] for k in STATIC_NAMES])
-            lin = np.zeros((2, 4))
-            for i in range(4):
-                if not lam[i] > 0:
-                    continue
-                step = np.sqrt(lam[i]) * U[:, i]
-                ys = []
-                for sgn in (1.0, -1.0):
-                    p_new = base + sgn * step
-                    if p_new[1] < p_new[0] or np.any(p_new <= 0):
-                        p_new = base + sgn * step * 0.5
-                    sets = {dd: dict(getattr(m, dd)) for dd in ("positive", "negative")}
-                    sets[d] = dict(zip(STATIC_NAMES, map(float, p_new)))
-                    rr = run(m.with_friction(**sets), float(est[0]), float(est[1]), False)
-                    ys.append(np.log([rr["sigma0"], rr["sigma1"]]) - np.log(est))
-                lin[:, i] = 0.5 * (ys[0] - ys[1])
-                static_var += lin[:, i] ** 2
-                static_bias += 0.5 * (ys[0] + ys[1])
-            # share of each static parameter: its loading on the principal axes
-            for j, k in enumerate(STATIC_NAMES):
-                contrib[f"{k} ({d})"] = lin @ (U[j, :] ** 2)
-        shifts = [static_var] if np.any(static_var > 0) else []
-        if shifts:
-            var = var + static_var
-            half = 1.96 * np.sqrt(var)
-            # the interval covers the estimate and the estimate less the mean shift:
-            # when the refits jump between local minima the curvature term is not
-            # to be trusted as a correction, only as a width
-            lo = est * np.exp(np.minimum(0.0, -static_bias) - half)
-            hi = est * np.exp(np.maximum(0.0, -static_bias) + half)
-            rel = (hi - lo) / (2 * est)
-            for j, k in enumerate(names):
-                share = static_var[j] / var[j]
-                was = identifiable[j]
-                # the combined verdict below supersedes the record-only one
-                notes = [n for n in notes if not n.startswith(f"{k} = ")]
-                identifiable[j] = bool(identifiable[j] and rel[j] <= 0.25)
-                big = sorted(contrib, key=lambda c: -abs(contrib[c][j]))[:2]
-                causes = ", ".join(f"{c} ({100 * abs(contrib[c][j]):.0f} % per standard "
-                                   "deviation)" for c in big)
-                notes.append(
-                    f"{k}: with the static step's joint covariance carried over, the 95 % "
-                    f"interval is [{lo[j]:.5g}, {hi[j]:.5g}] (+-{100 * rel[j]:.0f} %), "
-                    f"{100 * share:.0f} % of its variance from the static parameters "
-                    f"(largest: {causes}; their errors shift the estimate by "
-                    f"{100 * np.expm1(static_bias[j]):+.0f} % on average)"
-                    + ("; NOT determined: measure it directly (a presliding record at "
-                       "standstill, lugre.presliding) or tighten the static step around vs "
-                       "(lugre design-static)"
-                       if was and not identifiable[j] else ""))
+        lo, hi, identifiable, notes = _carry_static(
+            static_fit, m, est, lo, hi, identifiable, notes, int(static_draws),
+            lambda mm: run(mm, float(est[0]), float(est[1]), False))
     # an interval that cannot be computed (an estimate at the bound, a refit that
     # failed) says nothing: report it as unbounded and the parameter as undetermined
     for j, k in enumerate(names):

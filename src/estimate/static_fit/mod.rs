@@ -14,13 +14,15 @@
 //!
 //! Start values need no user input: for a fixed `vs` the curve is linear in
 //! `(fc, fs, sigma2)`, so a grid over `ln vs` with a robust linear fit at each node
-//! gives a start that gross errors do not pull away. With a rejecting weight function (IGG, Tukey) two such
-//! starts are followed to the end, a Huber grid and a least-trimmed-squares grid (the
-//! latter also resists gross errors at the fastest or slowest speeds, which have high
-//! leverage), and the fit with the smaller bounded loss is returned; the
-//! kept points are then refitted by plain least squares, with the rejections
-//! re-checked (beyond 4.685 scale units at least, the bisquare's rejection point),
-//! which recovers the efficiency the down-weighting band costs.
+//! gives a start that gross errors do not pull away. With a rejecting weight function
+//! (IGG, Tukey) several such starts are followed to the end, a Huber grid and
+//! least-trimmed-squares grids (which also resist gross errors at the fastest or
+//! slowest speeds, which have high leverage, and, at the trimmed fit's scale held
+//! fixed, a direction with half or more gross errors); each path's kept points are
+//! refitted by plain least squares, with the rejections re-checked (beyond 4.685 scale
+//! units at least, the bisquare's rejection point), which recovers the efficiency the
+//! down-weighting band costs, and the path with the largest likelihood of a
+//! Gaussian-plus-uniform mixture is returned.
 //!
 //! One idea per file: [`varpro`] the separable problem for fixed weights,
 //! [`reweight`] IRLS and the refit of the kept points, [`starts`] the robust starts
@@ -33,11 +35,11 @@ mod starts;
 mod varpro;
 
 use super::nelder_mead::NmOptions;
-use super::robust::{median, robust_scale, t_quantile_975, Weighting};
+use super::robust::{median, t_quantile_975, Weighting};
 use crate::error::{check_finite, check_len, Error, Result};
 use crate::friction::StaticSet;
 use reweight::{irls_vp, refit_kept, Cfg, Outcome, Stage};
-use starts::{clamp_start, lts_sizes, refine_lts, start_values_huber, start_values_lts};
+use starts::{clamp_start, lts_scale, lts_sizes, refine_lts, start_values_huber, start_values_lts};
 use varpro::Sep;
 
 /// Fewest nonzero-speed points per direction that [`fit_static`] accepts (4 parameters
@@ -178,33 +180,37 @@ fn fit_direction(
     };
     // One path: from a start, an optional IRLS pass with another weight function,
     // IRLS, then (rejecting weight functions) the least-squares refit on the kept points.
-    let path = |sep: &mut Sep, p0: [f64; 4], pre: Option<Weighting>| -> Outcome {
-        let mut p0 = p0;
-        let mut evals = 0;
-        if let Some(w) = pre {
-            let o = irls_vp(sep, p0, w, &cfg, Stage::Pre);
-            p0 = o.p;
-            evals = o.evals;
-        }
-        let refit = opts.refit_kept && reject_at.is_some();
-        let stage = if refit { Stage::Refit } else { Stage::Polish };
-        let mut out = irls_vp(sep, p0, opts.weighting, &cfg, stage);
-        out.evals += evals;
-        if let (true, Some(k1)) = (refit, reject_at) {
-            refit_kept(sep, &mut out, k1.max(reweight::REFIT_REJECT_MIN), &cfg);
-        }
-        out
-    };
+    // `fixed`: the residual scale held through both IRLS runs (an MM-estimate's M-step)
+    // instead of the MAD recomputed at each round.
+    let path =
+        |sep: &mut Sep, p0: [f64; 4], pre: Option<Weighting>, fixed: Option<f64>| -> Outcome {
+            let mut p0 = p0;
+            let mut evals = 0;
+            if let Some(w) = pre {
+                let o = irls_vp(sep, p0, w, &cfg, Stage::Pre, fixed);
+                p0 = o.p;
+                evals = o.evals;
+            }
+            let refit = opts.refit_kept && reject_at.is_some();
+            let stage = if refit { Stage::Refit } else { Stage::Polish };
+            let mut out = irls_vp(sep, p0, opts.weighting, &cfg, stage, fixed);
+            out.evals += evals;
+            if let (true, Some(k1)) = (refit, reject_at) {
+                refit_kept(sep, &mut out, k1.max(reweight::REFIT_REJECT_MIN), &cfg);
+            }
+            out
+        };
     let huber_start = clamp_start(start_values_huber(&mut sep), a, fscale);
     let out = if reject_at.is_some() {
         // Redescending weights (IGG, Tukey) settle on the set of rejected points near
-        // their start. Four starts, as in MM-estimation (Yohai 1987): (a) a Huber pass
-        // (monotone, unique fixed point) from the Huber grid; (b)-(d) a Tukey pass from
-        // least trimmed squares on half, three quarters and two fifths of the points
-        // (grid, then `vs` freed, [`lts_sizes`]), which also resist gross errors of high
-        // leverage (the fastest and slowest points) that a Huber fit follows. The fit with the smallest bounded (Tukey) loss at a common scale
-        // wins, as in the choice among local minima of an MM-estimate.
-        let mut paths = vec![path(&mut sep, huber_start, Some(Weighting::huber()))];
+        // their start. Seven starts, as in MM-estimation (Yohai 1987): (a) a Huber pass
+        // (monotone, unique fixed point, MAD scale) from the Huber grid; (b)-(d) the two
+        // best fits of least trimmed squares on half, three quarters and two fifths of
+        // the points (grid, then `vs` freed, [`lts_sizes`]), which also resist gross
+        // errors of high leverage (the fastest and slowest points) that a Huber fit
+        // follows, each followed by a Tukey pass and IGG at the trimmed fit's
+        // high-breakdown scale held fixed ([`lts_scale`]).
+        let mut paths = vec![path(&mut sep, huber_start, Some(Weighting::huber()), None)];
         let n = a.len();
         for h in lts_sizes(n) {
             let mut refined: Vec<(f64, [f64; 4])> = start_values_lts(&mut sep, h)
@@ -221,42 +227,44 @@ fn fit_direction(
                 .filter(|r| r.0.is_finite())
                 .collect();
             refined.sort_by(|x, y| x.0.total_cmp(&y.0));
-            for (_, p) in refined.into_iter().take(1) {
+            for (_, p) in refined.into_iter().take(2) {
+                let p = clamp_start(Some(p), a, fscale);
+                let s = lts_scale(&sep.residuals(&p), h);
                 paths.push(path(
                     &mut sep,
-                    clamp_start(Some(p), a, fscale),
+                    p,
                     Some(Weighting::tukey()),
+                    s.is_finite().then_some(s),
                 ));
             }
         }
-        // Tukey's rho at a common scale (the smallest robust scale of all): a
-        // rejected point costs the same in each, a kept one its misfit
-        let s = paths
-            .iter()
-            .map(|o| robust_scale(&o.residuals))
-            .fold(f64::INFINITY, f64::min)
-            .max(scale_floor);
-        let c = 4.685;
-        let rho = |o: &Outcome| -> f64 {
-            o.residuals
-                .iter()
-                .map(|e| {
-                    let u = (e / (c * s)).abs().min(1.0);
-                    1.0 - (1.0 - u * u).powi(3)
-                })
-                .sum()
+        // The choice among the paths (the local minima): the likelihood of a mixture,
+        // the kept points Gaussian at the path's own scale (that of its least-squares
+        // refit), the rejected ones uniform over the range of the forces (MLESAC, Torr
+        // and Zisserman 2000). A fit to a few points at a small scale pays for every
+        // clean point it leaves out, a compromise through the gross errors for its
+        // large scale; no common scale is needed, which a direction with half or more
+        // gross errors would inflate (the MAD) and a fit to a subset would shrink.
+        let ymax = y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let ymin = y.iter().copied().fold(f64::INFINITY, f64::min);
+        let width = (ymax - ymin).max(scale_floor);
+        let half_ln_2pi_e = 0.5 * (1.0 + (2.0 * std::f64::consts::PI).ln());
+        let cost = |o: &Outcome| -> f64 {
+            let kept = o.weights.iter().filter(|w| **w > 0.0).count() as f64;
+            let out = o.weights.len() as f64 - kept;
+            kept * (o.scale.max(scale_floor).ln() + half_ln_2pi_e) + out * width.ln()
         };
         let evals = paths.iter().map(|o| o.evals).sum();
         let mut best = paths
             .into_iter()
-            .map(|o| (rho(&o), o))
+            .map(|o| (cost(&o), o))
             .min_by(|x, y| x.0.total_cmp(&y.0))
             .map(|x| x.1)
             .expect("at least the Huber path");
         best.evals = evals;
         best
     } else {
-        path(&mut sep, huber_start, None)
+        path(&mut sep, huber_start, None, None)
     };
     if !out.p.iter().all(|v| v.is_finite()) {
         return Err(Error::Data(format!(

@@ -51,7 +51,7 @@ pub(super) fn max_rel_change(p: &[f64; 4], q: &[f64; 4]) -> f64 {
 }
 
 /// IRLS (eqs. 19-24): weights from the residuals at the current parameters and their
-/// robust scale, then the weighted profile minimised over `ln vs`, until the weights
+/// robust scale (or the fixed scale `fixed`, the M-step of an MM-estimate), then the weighted profile minimised over `ln vs`, until the weights
 /// or the parameters settle.
 pub(super) fn irls_vp(
     sep: &mut Sep,
@@ -59,10 +59,15 @@ pub(super) fn irls_vp(
     weighting: Weighting,
     cfg: &Cfg,
     stage: Stage,
+    fixed: Option<f64>,
 ) -> Outcome {
     let mut p = p0;
     let mut e = sep.residuals(&p);
-    let scale_of = |e: &[f64]| robust_scale(e).max(cfg.scale_floor);
+    let scale_of = |e: &[f64]| {
+        fixed
+            .unwrap_or_else(|| robust_scale(e))
+            .max(cfg.scale_floor)
+    };
     let mut s = scale_of(&e);
     let mut w = weighting.weights(&e, s);
     let mut evals = 1;

@@ -187,7 +187,7 @@ impl Lts {
 /// the grid instead of being repeated at every node.
 pub(super) fn start_values_lts(sep: &mut Sep, h: usize) -> Vec<[f64; 4]> {
     let n = sep.a.len();
-    const SEEDS_PER_NODE: usize = 12;
+    const SEEDS_PER_NODE: usize = 36;
     let nodes = grid_nodes(sep.a, GRID_NODES);
     let seeds = elemental_seeds(sep.a, SEEDS_PER_NODE * nodes.len());
     let mut lts = Lts {
@@ -327,6 +327,63 @@ pub(super) fn lts_sizes(n: usize) -> [usize; 3] {
     ]
 }
 
+/// Variance of a standard Gaussian truncated to `|z| <= k`.
+pub(super) fn truncated_variance(k: f64) -> f64 {
+    let phi = (-0.5 * k * k).exp() / (2.0 * std::f64::consts::PI).sqrt();
+    1.0 - 2.0 * k * phi / libm::erf(k / std::f64::consts::SQRT_2)
+}
+
+/// Reweighting cut-off of [`lts_scale`], in units of the raw trimmed scale.
+const LTS_REWEIGHT_CUT: f64 = 2.5;
+
+/// High-breakdown residual scale of a least-trimmed-squares fit (the scale an
+/// MM-estimate holds fixed in its M-step, Yohai 1987; reweighted as in Rousseeuw and
+/// Van Driessen 2006). The raw scale is the root mean of the `h` smallest squared
+/// residuals on `h - 4` degrees of freedom (the fit brought them down), made consistent
+/// for Gaussian errors (the central fraction `h/n`); twice, the points within
+/// [`LTS_REWEIGHT_CUT`] scales then give the scale on `kept - 4` degrees of freedom,
+/// consistent for the truncation. Unlike the MAD of all residuals,
+/// it does not grow with the share of gross errors as long as the `h` points are clean,
+/// also when a direction holds half or more gross errors.
+pub(super) fn lts_scale(e: &[f64], h: usize) -> f64 {
+    let n = e.len();
+    let h = h.clamp(1, n.max(1));
+    let mut r2: Vec<f64> = e.iter().map(|x| x * x).filter(|x| !x.is_nan()).collect();
+    if r2.len() < h {
+        return f64::NAN;
+    }
+    r2.sort_by(|a, b| a.total_cmp(b));
+    let frac = h as f64 / n as f64;
+    // central quantile q of |z| with P(|z| <= q) = frac, by bisection on erf
+    let (mut lo, mut hi) = (0.0f64, 10.0f64);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if libm::erf(mid / std::f64::consts::SQRT_2) < frac {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    // the fit had 4 parameters to bring the `h` residuals down
+    let dof = (h as f64 - 4.0).max(1.0);
+    let mut s = (r2[..h].iter().sum::<f64>() / dof / truncated_variance(0.5 * (lo + hi))).sqrt();
+    if s == 0.0 {
+        return s;
+    }
+    for _ in 0..2 {
+        let cut2 = (LTS_REWEIGHT_CUT * s).powi(2);
+        let kept: Vec<f64> = r2.iter().copied().take_while(|x| *x <= cut2).collect();
+        if kept.len() <= 4 {
+            break;
+        }
+        s = (kept.iter().sum::<f64>()
+            / (kept.len() - 4) as f64
+            / truncated_variance(LTS_REWEIGHT_CUT))
+        .sqrt();
+    }
+    s
+}
+
 /// Keep start values inside the model's domain (all positive, `fs > fc`).
 pub(super) fn clamp_start(p: Option<[f64; 4]>, a: &[f64], fscale: f64) -> [f64; 4] {
     let amin = a.iter().copied().fold(f64::INFINITY, f64::min);
@@ -339,4 +396,45 @@ pub(super) fn clamp_start(p: Option<[f64; 4]>, a: &[f64], fscale: f64) -> [f64; 
     p[2] = p[2].max(1e-6 * fscale / amax.max(1e-300));
     p[3] = p[3].clamp(amin * 0.5, amax * 2.0);
     p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Deterministic standard-normal-like residuals (inverse CDF on a grid).
+    fn gaussian(n: usize, sd: f64) -> Vec<f64> {
+        (0..n)
+            .map(|k| {
+                let p = (k as f64 + 0.5) / n as f64;
+                // bisection on erf for the quantile
+                let (mut lo, mut hi) = (-10.0f64, 10.0f64);
+                for _ in 0..80 {
+                    let m = 0.5 * (lo + hi);
+                    if 0.5 * (1.0 + libm::erf(m / std::f64::consts::SQRT_2)) < p {
+                        lo = m;
+                    } else {
+                        hi = m;
+                    }
+                }
+                sd * 0.5 * (lo + hi)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn lts_scale_is_consistent_and_resists_half_gross_errors() {
+        let clean = gaussian(400, 0.3);
+        let h = lts_sizes(clean.len())[2];
+        let s = lts_scale(&clean, h);
+        assert!((s / 0.3 - 1.0).abs() < 0.05, "{s}");
+        // as many gross errors as clean points, all on one side
+        let mut mixed = gaussian(200, 0.3);
+        mixed.extend((0..200).map(|k| 5.0 + 0.1 * k as f64));
+        let s = lts_scale(&mixed, lts_sizes(mixed.len())[2]);
+        assert!((s / 0.3 - 1.0).abs() < 0.1, "{s}");
+        let mad = crate::estimate::robust_scale(&mixed);
+        assert!(mad > 10.0 * s, "{mad} {s}");
+        assert!(lts_scale(&[0.0; 8], 5) == 0.0);
+    }
 }
