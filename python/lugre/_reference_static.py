@@ -6,9 +6,10 @@ For a fixed ``vs`` the curve ``fc + (fs - fc)*phi + sigma2*a``, ``phi = exp(-(a/
 is linear: the linear part comes from the 3x3 weighted normal equations (column-scaled
 Cholesky, signs kept by an exhaustive active set), so every weighted problem is a
 search over ``ln vs`` (a bracket, then Nelder-Mead). Starts: a Huber grid over
-``ln vs`` and least trimmed squares on three subset sizes; IRLS with the chosen
-weights from each; the kept points refitted by least squares; the path of smallest
-Tukey loss wins; covariance from the weighted Jacobian.
+``ln vs`` and the two best least-trimmed-squares fits on each of three subset sizes;
+IRLS with the chosen weights from each (from the trimmed fits at their high-breakdown
+scale held fixed); the kept points refitted by least squares; the path of largest
+Gaussian-plus-uniform mixture likelihood wins; covariance from the weighted Jacobian.
 
 The operations follow the Rust code in the same order. Where the core's order is that
 of an unstable selection (the subsets of the trimmed fits), sums may be taken in
@@ -36,7 +37,8 @@ MIN_POINTS_PER_DIRECTION = 5
 STATIC_PARAM_NAMES = ("fc", "fs", "sigma2", "vs")
 GRID_NODES = 17
 LTS_CANDIDATES = 4
-SEEDS_PER_NODE = 12
+SEEDS_PER_NODE = 36
+LTS_REWEIGHT_CUT = 2.5
 REFIT_REJECT_MIN = 4.685
 _exp = math.exp
 _MASK = 0xFFFF_FFFF_FFFF_FFFF
@@ -454,6 +456,64 @@ def _lts_sizes(n: int) -> list[int]:
     return [clamp((n + 4) // 2), clamp(-(-3 * n // 4)), clamp(-(-2 * n // 5))]
 
 
+def _truncated_variance(k: float) -> float:
+    """Variance of a standard Gaussian truncated to ``|z| <= k``."""
+    phi = _exp(-0.5 * k * k) / math.sqrt(2.0 * math.pi)
+    return 1.0 - 2.0 * k * phi / math.erf(k / math.sqrt(2.0))
+
+
+def _lts_scale(e: list[float], h: int) -> float:
+    """High-breakdown scale of a trimmed fit (``lts_scale``): the ``h`` smallest squared
+    residuals on ``h - 4`` degrees of freedom, consistent for the central fraction
+    ``h/n``, then twice the points within 2.5 scales on ``kept - 4``."""
+    n = len(e)
+    h = min(max(h, 1), max(n, 1))
+    r2 = [x * x for x in e]
+    r2 = [x for x in r2 if not math.isnan(x)]
+    if len(r2) < h:
+        return math.nan
+    r2.sort()
+    frac = h / n
+    lo, hi = 0.0, 10.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if math.erf(mid / math.sqrt(2.0)) < frac:
+            lo = mid
+        else:
+            hi = mid
+    dof = max(h - 4.0, 1.0)
+    total = 0.0
+    for x in r2[:h]:
+        total += x
+    s = math.sqrt(total / dof / _truncated_variance(0.5 * (lo + hi)))
+    if s == 0.0:
+        return s
+    for _ in range(2):
+        c = LTS_REWEIGHT_CUT * s
+        cut2 = c * c
+        kept = []
+        for x in r2:
+            if not x <= cut2:
+                break
+            kept.append(x)
+        if len(kept) <= 4:
+            break
+        total = 0.0
+        for x in kept:
+            total += x
+        s = math.sqrt(total / (len(kept) - 4) / _truncated_variance(LTS_REWEIGHT_CUT))
+    return s
+
+
+def _fmax(a: float, b: float) -> float:
+    """``f64::max``: the other operand when one is NaN."""
+    if math.isnan(a):
+        return b
+    if math.isnan(b):
+        return a
+    return max(a, b)
+
+
 def _clamp_start(p: P4 | None, a: list[float], fscale: float) -> P4:
     amin, amax = min(a), max([0.0, *a])
     if p is None or not all(math.isfinite(v) for v in p):
@@ -492,13 +552,16 @@ def _max_rel_change(p: P4, q: P4) -> float:
     return m
 
 
-def _irls_vp(sep: _Sep, p0: P4, weighting: Weighting, cfg: _Cfg, stage: str) -> _Outcome:
-    """IRLS (eqs. 19-24) over the profile; ``stage`` is ``pre``, ``refit`` or ``polish``."""
+def _irls_vp(sep: _Sep, p0: P4, weighting: Weighting, cfg: _Cfg, stage: str,
+             fixed: float | None = None) -> _Outcome:
+    """IRLS (eqs. 19-24) over the profile; ``stage`` is ``pre``, ``refit`` or ``polish``;
+    ``fixed``: a scale held through the rounds (an MM-estimate's M-step) instead of the
+    MAD."""
     p = p0
     e = sep.residuals(p)
 
     def scale_of(e: list[float]) -> float:
-        return max(robust_scale(e), cfg.scale_floor)
+        return _fmax(robust_scale(e) if fixed is None else fixed, cfg.scale_floor)
 
     s = scale_of(e)
     w = weighting.weights(e, s)
@@ -661,13 +724,13 @@ def _fit_direction(a: list[float], y: list[float], sign: float, indices: list[in
     cfg = _Cfg(max_iter, 1e-7, floor, 4000)
     reject_at = weighting.rejects_at
 
-    def path(p0: P4, pre: Weighting | None) -> _Outcome:
+    def path(p0: P4, pre: Weighting | None, fixed: float | None = None) -> _Outcome:
         evals = 0
         if pre is not None:
-            o = _irls_vp(sep, p0, pre, cfg, "pre")
+            o = _irls_vp(sep, p0, pre, cfg, "pre", fixed)
             p0, evals = o.p, o.evals
         refit = reject_at is not None
-        out = _irls_vp(sep, p0, weighting, cfg, "refit" if refit else "polish")
+        out = _irls_vp(sep, p0, weighting, cfg, "refit" if refit else "polish", fixed)
         out.evals += evals
         if reject_at is not None:
             _refit_kept(sep, out, max(reject_at, REFIT_REJECT_MIN), cfg)
@@ -675,32 +738,36 @@ def _fit_direction(a: list[float], y: list[float], sign: float, indices: list[in
 
     huber_start = _clamp_start(_start_values_huber(sep), a, fscale)
     if reject_at is not None:
-        # four starts as in MM-estimation: a Huber pass from the Huber grid, a Tukey pass
-        # from least trimmed squares on each subset size; the smallest Tukey loss wins
+        # seven starts as in MM-estimation: a Huber pass from the Huber grid (MAD
+        # scale); from the two best trimmed fits of each subset size a Tukey pass and
+        # IGG at the trimmed fit's scale held fixed; the largest likelihood of a
+        # Gaussian-plus-uniform mixture (each path at its own refit scale) wins
         paths = [path(huber_start, Weighting.huber())]
         for h in _lts_sizes(len(a)):
             refined = [_refine_lts(sep, _clamp_start(p0, a, fscale), h, cfg.nm_pre,
                                    cfg.obj_floor) for p0 in _start_values_lts(sep, h)]
             refined = [r for r in refined if math.isfinite(r[0])]
             refined.sort(key=lambda r: r[0])
-            for _, p in refined[:1]:
-                paths.append(path(_clamp_start(p, a, fscale), Weighting.tukey()))
-        s = math.inf
-        for o in paths:
-            s = min(s, robust_scale(o.residuals))
-        s = max(s, floor)
-        c = 4.685
+            for _, p in refined[:2]:
+                p = _clamp_start(p, a, fscale)
+                s = _lts_scale(sep.residuals(p), h)
+                paths.append(path(p, Weighting.tukey(), s if math.isfinite(s) else None))
+        width = _fmax(max(y) - min(y), floor)
+        half_ln_2pi_e = 0.5 * (1.0 + math.log(2.0 * math.pi))
 
-        def rho(o: _Outcome) -> float:
-            total = 0.0
-            for e in o.residuals:
-                u = min(abs(e / (c * s)), 1.0)
-                q = 1.0 - u * u
-                total += 1.0 - q * q * q
-            return total
+        def cost(o: _Outcome) -> float:
+            kept = float(sum(1 for w in o.weights if w > 0.0))
+            out = len(o.weights) - kept
+            return kept * (_ln(_fmax(o.scale, floor)) + half_ln_2pi_e) + out * _ln(width)
 
         evals = sum(o.evals for o in paths)
-        out = min(paths, key=rho)
+        costs = [cost(o) for o in paths]
+        best = 0
+        for k in range(1, len(paths)):
+            # min_by with total_cmp: the first of equal costs, NaN above everything
+            if costs[k] < costs[best] or (math.isnan(costs[best]) and not math.isnan(costs[k])):
+                best = k
+        out = paths[best]
         out.evals = evals
     else:
         out = path(huber_start, None)
