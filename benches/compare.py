@@ -335,7 +335,7 @@ def scipy_static_fit(v: np.ndarray, f: np.ndarray) -> list[np.ndarray]:
 
 def static_fit(quick: bool) -> None:
     print("\nstatic (Stribeck) fit, both directions (time per fit)")
-    for n in (20, 100) if quick else (20, 100, 1000):
+    for n in (20, 100) if quick else (20, 100, 1000, 10000):
         v, f = static_points(n)
         tl, fit = best(lambda v=v, f=f: lugre.fit_static(v, f), 5)
         ts, ps = best(lambda v=v, f=f: scipy_static_fit(v, f), 5)
