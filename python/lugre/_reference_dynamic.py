@@ -8,7 +8,10 @@ Gauss-Newton steps refine it and give the coordinates in which the simplex works
 intervals come from the weighted Jacobian, widened for serially correlated residuals.
 The steps are the core's, in the same order (the core runs the grid and the Jacobian
 columns in parallel; each simulation is the same). With ``static_fit`` the static
-step's covariance is carried over as in :func:`lugre.identify.fit_dynamic`.
+step's covariance is carried over by the facade's own Python
+(:func:`lugre.identify._carry_static`: draws from the static covariance and refits at
+the ends of its confidence region), called with this module's refits, so the twin
+follows the facade wherever that handling goes.
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ import numpy as np
 
 from ._reference_nm import NmOptions, minimize
 from ._reference_robust import Weighting, robust_scale
-from ._reference_static import _as_points, _check_finite, _usize
+from ._reference_static import _as_points, _check_finite, _div, _usize
 from .exceptions import (
     ConvergenceWarning,
     DataError,
@@ -32,7 +35,7 @@ from .exceptions import (
     ModelError,
     ParameterError,
 )
-from .identify import STATIC_NAMES, DynamicFit, StaticFit, _check_stick_slip
+from .identify import DynamicFit, StaticFit, _carry_static, _check_stick_slip
 from .io import Recording, read_recording
 from .model import Model, ModelLike, _as_model, _Parsed
 from .reference import _check_time, _parsed, _simulate
@@ -377,7 +380,7 @@ def _fit_record(m: _Parsed, t: list[float], x_ref: list[float], x_meas: list[flo
                 std_err[k] = est[k] * se_th[k]
                 ci_low[k] = est[k] * _exp(-1.96 * se_th[k])
                 ci_high[k] = est[k] * _exp(1.96 * se_th[k])
-                rel[k] = (ci_high[k] - ci_low[k]) / (2.0 * est[k])
+                rel[k] = _div(ci_high[k] - ci_low[k], 2.0 * est[k])
         else:
             singular = True
     else:
@@ -411,7 +414,7 @@ def _fit_record(m: _Parsed, t: list[float], x_ref: list[float], x_meas: list[flo
     if bias > 0.1 * s1:
         notes.append(f"sigma1 is confounded with sigma2 (the presliding damping is sigma1 + "
                      f"sigma2): a {_fmt(s2_rel * 100.0, '.1f')} % error in sigma2 "
-                     f"({_fmt(bias, '.3f')} N s/m) is {_fmt(100.0 * bias / s1, '.0f')} % of "
+                     f"({_fmt(bias, '.3f')} N s/m) is {_fmt(_div(100.0 * bias, s1), '.0f')} % of "
                      "sigma1; reduce sigma2's uncertainty (more fast constant-velocity "
                      "points) before trusting sigma1")
     if rho > 0.5:
@@ -468,7 +471,7 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
                 sigma1_start: float | None = None, grid: bool = True, max_iter: int = 20,
                 scale_floor: float = 0.0, substeps: int = 1, integrator: str = "exact",
                 columns: dict[str, str] | None = None,
-                static_fit: StaticFit | None = None) -> DynamicFit:
+                static_fit: StaticFit | None = None, static_draws: int = 39) -> DynamicFit:
     """Estimate sigma0 and sigma1 from a closed-loop record (seed paper, eq. 18): NumPy
     twin of :func:`lugre.fit_dynamic`, with the same parameters, result, warnings and
     errors (see there).
@@ -483,6 +486,10 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
     if rec.x_ref is None:
         raise InputError.at("x_ref", f"{rec.source or 'the recording'} has no x_ref column: "
                             "the dynamic fit simulates the closed loop on the reference")
+    if static_fit is not None and not (isinstance(static_draws, (int, np.integer))
+                                       and static_draws >= 5):
+        raise InputError.at("static_draws", f"is {static_draws!r}: give a whole number of at "
+                            "least 5")
 
     def run(mm: Model, s0: float | None, s1: float | None, use_grid: bool) -> dict[str, Any]:
         return _record_call(mm, rec, weighting, c1, c2, s0, s1, use_grid, max_iter,
@@ -496,64 +503,9 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
     notes = list(r["notes"])
     identifiable = [bool(b) for b in r["identifiable"]]
     if static_fit is not None:
-        # the static step's joint covariance carried by sigma points, as the facade does
-        # (lugre.identify.fit_dynamic): per direction, refits with the static set moved
-        # by +-1 standard deviation along each principal axis of its covariance
-        var = ((np.log(hi) - np.log(lo)) / (2 * 1.96)) ** 2
-        static_var = np.zeros(2)
-        static_bias = np.zeros(2)
-        contrib: dict[str, np.ndarray] = {}
-        for d in ("positive", "negative"):
-            df = getattr(static_fit, d)
-            C = np.asarray(df.cov, float)
-            if not np.all(np.isfinite(C)):
-                C = np.diag([df.std_err[k] ** 2 if np.isfinite(df.std_err[k]) else 0.0
-                             for k in STATIC_NAMES])
-            lam, U = np.linalg.eigh(0.5 * (C + C.T))
-            base = np.array([getattr(m, d)[k] for k in STATIC_NAMES])
-            lin = np.zeros((2, 4))
-            for i in range(4):
-                if not lam[i] > 0:
-                    continue
-                step = np.sqrt(lam[i]) * U[:, i]
-                ys = []
-                for sgn in (1.0, -1.0):
-                    p_new = base + sgn * step
-                    if p_new[1] < p_new[0] or np.any(p_new <= 0):
-                        p_new = base + sgn * step * 0.5
-                    sets = {dd: dict(getattr(m, dd)) for dd in ("positive", "negative")}
-                    sets[d] = dict(zip(STATIC_NAMES, map(float, p_new)))
-                    rr = run(m.with_friction(**sets), float(est[0]), float(est[1]), False)
-                    ys.append(np.log([rr["sigma0"], rr["sigma1"]]) - np.log(est))
-                lin[:, i] = 0.5 * (ys[0] - ys[1])
-                static_var += lin[:, i] ** 2
-                static_bias += 0.5 * (ys[0] + ys[1])
-            for j, k in enumerate(STATIC_NAMES):
-                contrib[f"{k} ({d})"] = lin @ (U[j, :] ** 2)
-        if np.any(static_var > 0):
-            var = var + static_var
-            half = 1.96 * np.sqrt(var)
-            lo = est * np.exp(np.minimum(0.0, -static_bias) - half)
-            hi = est * np.exp(np.maximum(0.0, -static_bias) + half)
-            rel = (hi - lo) / (2 * est)
-            for j, k in enumerate(names):
-                share = static_var[j] / var[j]
-                was = identifiable[j]
-                notes = [n for n in notes if not n.startswith(f"{k} = ")]
-                identifiable[j] = bool(identifiable[j] and rel[j] <= 0.25)
-                big = sorted(contrib, key=lambda c: -abs(contrib[c][j]))[:2]
-                causes = ", ".join(f"{c} ({100 * abs(contrib[c][j]):.0f} % per standard "
-                                   "deviation)" for c in big)
-                notes.append(
-                    f"{k}: with the static step's joint covariance carried over, the 95 % "
-                    f"interval is [{lo[j]:.5g}, {hi[j]:.5g}] (+-{100 * rel[j]:.0f} %), "
-                    f"{100 * share:.0f} % of its variance from the static parameters "
-                    f"(largest: {causes}; their errors shift the estimate by "
-                    f"{100 * np.expm1(static_bias[j]):+.0f} % on average)"
-                    + ("; NOT determined: measure it directly (a presliding record at "
-                       "standstill, lugre.presliding) or tighten the static step around vs "
-                       "(lugre design-static)"
-                       if was and not identifiable[j] else ""))
+        lo, hi, identifiable, notes = _carry_static(
+            static_fit, m, est, lo, hi, identifiable, notes, int(static_draws),
+            lambda mm: run(mm, float(est[0]), float(est[1]), False))
     for j, k in enumerate(names):
         if not (np.isfinite(lo[j]) and np.isfinite(hi[j])):
             lo, hi = np.array(lo, float), np.array(hi, float)
