@@ -18,6 +18,7 @@ They assume a release build of the extension (as CI and ``pip install .`` make).
 from __future__ import annotations
 
 import _thread
+import signal
 import subprocess
 import sys
 import textwrap
@@ -132,6 +133,11 @@ def _interrupt_after(seconds: float) -> threading.Timer:
 
 
 def _time_to_interrupt(call: Callable[[], Any], after: float) -> float:
+    # a process started in the background by a non-interactive shell inherits SIGINT
+    # ignored, and then interrupt_main() does nothing: handle it as Python normally does
+    old = signal.getsignal(signal.SIGINT)
+    if old in (signal.SIG_IGN, signal.SIG_DFL, None):
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     tm = _interrupt_after(after)
     t0 = time.perf_counter()
     try:
@@ -142,6 +148,8 @@ def _time_to_interrupt(call: Callable[[], Any], after: float) -> float:
             time.sleep(0.5)
     finally:
         tm.cancel()
+        if old in (signal.SIG_IGN, signal.SIG_DFL):
+            signal.signal(signal.SIGINT, old)
     return time.perf_counter() - t0
 
 
