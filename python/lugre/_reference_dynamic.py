@@ -17,7 +17,6 @@ follows the facade wherever that handling goes.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import replace
 from typing import Any, Callable
 
@@ -27,17 +26,15 @@ from ._reference_nm import NmOptions, minimize
 from ._reference_robust import Weighting, robust_scale
 from ._reference_static import _as_points, _check_finite, _div, _usize
 from .exceptions import (
-    ConvergenceWarning,
     DataError,
-    IdentifiabilityWarning,
     InputError,
     LugreError,
     ModelError,
     ParameterError,
 )
-from .identify import DynamicFit, StaticFit, _carry_static, _check_stick_slip
-from .io import Recording, read_recording
-from .model import Model, ModelLike, _as_model, _Parsed
+from .identify import DynamicFit, StaticFit, _dynamic_fit
+from .io import Recording
+from .model import Model, ModelLike, _Parsed
 from .reference import _check_time, _parsed, _simulate
 
 __all__ = ["DynamicFit", "fit_dynamic"]
@@ -480,58 +477,11 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
     """
     from . import _table_or_same
 
-    recording = _table_or_same(recording)
-    m = _as_model(model)
-    rec = recording if isinstance(recording, Recording) else read_recording(recording, columns)
-    if rec.x_ref is None:
-        raise InputError.at("x_ref", f"{rec.source or 'the recording'} has no x_ref column: "
-                            "the dynamic fit simulates the closed loop on the reference")
-    if static_fit is not None and not (isinstance(static_draws, (int, np.integer))
-                                       and static_draws >= 5):
-        raise InputError.at("static_draws", f"is {static_draws!r}: give a whole number of at "
-                            "least 5")
-
-    def run(mm: Model, s0: float | None, s1: float | None, use_grid: bool) -> dict[str, Any]:
+    def twin(mm: Model, rec: Recording, s0: float | None, s1: float | None,
+             use_grid: bool) -> dict[str, Any]:
         return _record_call(mm, rec, weighting, c1, c2, s0, s1, use_grid, max_iter,
                             scale_floor, substeps, integrator)
 
-    _check_stick_slip(rec)
-    r = run(m, sigma0_start, sigma1_start, bool(grid))
-    names = ("sigma0", "sigma1")
-    est = np.array([r["sigma0"], r["sigma1"]], dtype=float)
-    lo, hi = np.asarray(r["ci_low"], float), np.asarray(r["ci_high"], float)
-    notes = list(r["notes"])
-    identifiable = [bool(b) for b in r["identifiable"]]
-    if static_fit is not None:
-        lo, hi, identifiable, notes = _carry_static(
-            static_fit, m, est, lo, hi, identifiable, notes, int(static_draws),
-            lambda mm: run(mm, float(est[0]), float(est[1]), False))
-    for j, k in enumerate(names):
-        if not (np.isfinite(lo[j]) and np.isfinite(hi[j])):
-            lo, hi = np.array(lo, float), np.array(hi, float)
-            lo[j], hi[j] = 0.0, np.inf
-            if identifiable[j]:
-                notes.append(f"{k}: its interval cannot be computed (estimate {est[j]:.4g} "
-                             "at or near a bound): NOT determined by this record")
-            identifiable[j] = False
-    fit = DynamicFit(
-        sigma0=float(est[0]), sigma1=float(est[1]),
-        std_err=dict(zip(names, map(float, r["std_err"]))),
-        ci95={k: (float(a), float(b)) for k, a, b in zip(names, lo, hi)},
-        identifiable=dict(zip(names, identifiable)),
-        correlation=float(r["correlation"]), notes=notes,
-        residuals=r["residuals"], weights=r["weights"], rms_error=float(r["rms_error"]),
-        max_error=float(r["max_error"]), iterations=int(r["iterations"]),
-        evaluations=int(r["evaluations"]), converged=bool(r["converged"]),
-        model=m.with_friction(sigma0=float(est[0]), sigma1=float(est[1])),
-    )
-    for k in names:
-        if not fit.identifiable[k]:
-            lo_k, hi_k = fit.ci95[k]
-            warnings.warn(f"{k} is not determined by this record (95 % interval "
-                          f"[{lo_k:.4g}, {hi_k:.4g}]); the fit's notes say which experiment "
-                          "would determine it", IdentifiabilityWarning, stacklevel=2)
-    if not fit.converged:
-        warnings.warn("dynamic fit: IRLS reached its iteration limit", ConvergenceWarning,
-                      stacklevel=2)
-    return fit
+    return _dynamic_fit(twin, _table_or_same(recording), model, sigma0_start=sigma0_start,
+                        sigma1_start=sigma1_start, grid=grid, columns=columns,
+                        static_fit=static_fit, static_draws=static_draws)

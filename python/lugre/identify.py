@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -520,6 +520,26 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
     IdentifiabilityWarning
         A parameter is not determined by the record (its notes say what would).
     """
+    def core(mm: Model, rec: Recording, s0: float | None, s1: float | None,
+             use_grid: bool) -> dict[str, Any]:
+        return _core.fit_dynamic_record(
+            mm._core_model(), rec.t, rec.x_ref, rec.x, str(weighting), float(c1),
+            float(c2), s0, s1, use_grid, int(max_iter), float(scale_floor), int(substeps),
+            str(integrator))
+
+    return _dynamic_fit(core, recording, model, sigma0_start=sigma0_start,
+                        sigma1_start=sigma1_start, grid=grid, columns=columns,
+                        static_fit=static_fit, static_draws=static_draws)
+
+
+def _dynamic_fit(record_fit: Callable[..., dict[str, Any]], recording: Recording | str,
+                 model: ModelLike, *, sigma0_start: float | None,
+                 sigma1_start: float | None, grid: bool, columns: dict[str, str] | None,
+                 static_fit: StaticFit | None, static_draws: int) -> DynamicFit:
+    """:func:`fit_dynamic` around ``record_fit(model, recording, sigma0_start,
+    sigma1_start, grid)``, the fit of one record (the core's binding, or the NumPy twin's
+    in ``lugre.reference``): input checks, the static step's uncertainty, the result,
+    its warnings."""
     m = _as_model(model)
     rec = recording if isinstance(recording, Recording) else read_recording(recording, columns)
     if rec.x_ref is None:
@@ -531,10 +551,7 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
                             "least 5")
 
     def run(mm: Model, s0: float | None, s1: float | None, use_grid: bool) -> dict[str, Any]:
-        return _core.fit_dynamic_record(
-            mm._core_model(), rec.t, rec.x_ref, rec.x, str(weighting), float(c1),
-            float(c2), s0, s1, use_grid, int(max_iter), float(scale_floor), int(substeps),
-            str(integrator))
+        return record_fit(mm, rec, s0, s1, use_grid)
 
     _check_stick_slip(rec)
     r = run(m, sigma0_start, sigma1_start, bool(grid))
@@ -573,10 +590,10 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
             lo_k, hi_k = fit.ci95[k]
             warnings.warn(f"{k} is not determined by this record (95 % interval "
                           f"[{lo_k:.4g}, {hi_k:.4g}]); the fit's notes say which experiment "
-                          "would determine it", IdentifiabilityWarning, stacklevel=2)
+                          "would determine it", IdentifiabilityWarning, stacklevel=3)
     if not fit.converged:
         warnings.warn("dynamic fit: IRLS reached its iteration limit", ConvergenceWarning,
-                      stacklevel=2)
+                      stacklevel=3)
     return fit
 
 
