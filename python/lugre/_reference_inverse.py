@@ -63,7 +63,6 @@ def _interp(x: np.ndarray, xp: Any, fp: Any) -> np.ndarray:
         elif xv >= xp[m - 1]:
             out[k] = fp[m - 1]
         else:
-            j = 0
             lo, hi = 0, m
             while lo < hi:  # partition point of xp <= xv
                 mid = (lo + hi) // 2

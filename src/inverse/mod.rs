@@ -372,7 +372,7 @@ impl Record {
     /// Filtered force the model needs besides the motor: `m*a + F_friction + F_effects`
     /// (with a `resonance`: `(1 - r)*m*a + F_coupling`).
     pub fn model_force(&self, model: &Model) -> Result<Vec<f64>> {
-        let m = total_mass(model);
+        let m = model.total_mass();
         let res = model.effects.iter().find_map(|e| match e {
             Effect::Resonance { load_fraction, .. } => Some(*load_fraction),
             _ => None,
@@ -510,11 +510,6 @@ impl Record {
 /// The model's Stribeck exponent when it is not 2.
 fn exponent_of(model: &Model) -> Option<f64> {
     model.stribeck_exponent().filter(|&e| e != 2.0)
-}
-
-/// Axis mass plus every `mass` effect.
-fn total_mass(model: &Model) -> f64 {
-    model.total_mass()
 }
 
 /// `sign(f)*max(|f| - band, 0)`.

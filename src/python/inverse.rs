@@ -72,6 +72,25 @@ fn vec_of(name: &str, a: &PyReadonlyArray1<'_, f64>) -> Result<Vec<f64>, Error> 
     Ok(slice(name, a)?.to_vec())
 }
 
+impl PyInverseRecord {
+    /// One signal of the record under `model`, computed with the interpreter released.
+    fn signal<'py>(
+        &self,
+        py: Python<'py>,
+        model: &Bound<'py, PyAny>,
+        f: impl FnOnce(&Record, &Model) -> Result<Vec<f64>, Error> + Send,
+    ) -> PyResult<F64Array<'py>> {
+        let m = model_of(py, model)?;
+        let r = py.detach(|| f(&self.rec, &m)).map_err(|e| to_py(py, e))?;
+        Ok(r.into_pyarray(py))
+    }
+}
+
+/// Columns of equal length `n` as an `(n, columns)` matrix.
+fn columns(n: usize, cols: &[Vec<f64>]) -> Array2<f64> {
+    Array2::from_shape_fn((n, cols.len()), |(k, j)| cols[j][k])
+}
+
 #[pymethods]
 impl PyInverseRecord {
     #[new]
@@ -157,8 +176,7 @@ impl PyInverseRecord {
         py: Python<'py>,
         model: &Bound<'py, PyAny>,
     ) -> PyResult<F64Array<'py>> {
-        let m = model_of(py, model)?;
-        Ok(py.detach(|| self.rec.base_friction(&m)).into_pyarray(py))
+        self.signal(py, model, |r, m| Ok(r.base_friction(m)))
     }
 
     /// Unfiltered sum of the effect forces.
@@ -167,8 +185,7 @@ impl PyInverseRecord {
         py: Python<'py>,
         model: &Bound<'py, PyAny>,
     ) -> PyResult<F64Array<'py>> {
-        let m = model_of(py, model)?;
-        Ok(py.detach(|| self.rec.effect_force(&m)).into_pyarray(py))
+        self.signal(py, model, |r, m| Ok(r.effect_force(m)))
     }
 
     /// Unfiltered force of the resonance coupling on the load.
@@ -177,11 +194,7 @@ impl PyInverseRecord {
         py: Python<'py>,
         model: &Bound<'py, PyAny>,
     ) -> PyResult<F64Array<'py>> {
-        let m = model_of(py, model)?;
-        let r = py
-            .detach(|| self.rec.coupling_force(&m))
-            .map_err(|e| to_py(py, e))?;
-        Ok(r.into_pyarray(py))
+        self.signal(py, model, Record::coupling_force)
     }
 
     /// Filtered force the model needs besides the motor.
@@ -190,11 +203,7 @@ impl PyInverseRecord {
         py: Python<'py>,
         model: &Bound<'py, PyAny>,
     ) -> PyResult<F64Array<'py>> {
-        let m = model_of(py, model)?;
-        let r = py
-            .detach(|| self.rec.model_force(&m))
-            .map_err(|e| to_py(py, e))?;
-        Ok(r.into_pyarray(py))
+        self.signal(py, model, Record::model_force)
     }
 
     /// Filtered motor force after delay, dead-band and current lag.
@@ -203,17 +212,12 @@ impl PyInverseRecord {
         py: Python<'py>,
         model: &Bound<'py, PyAny>,
     ) -> PyResult<F64Array<'py>> {
-        let m = model_of(py, model)?;
-        Ok(py.detach(|| self.rec.motor_force(&m)).into_pyarray(py))
+        self.signal(py, model, |r, m| Ok(r.motor_force(m)))
     }
 
     /// Force residual.
     fn residual<'py>(&self, py: Python<'py>, model: &Bound<'py, PyAny>) -> PyResult<F64Array<'py>> {
-        let m = model_of(py, model)?;
-        let r = py
-            .detach(|| self.rec.residual(&m))
-            .map_err(|e| to_py(py, e))?;
-        Ok(r.into_pyarray(py))
+        self.signal(py, model, Record::residual)
     }
 
     /// Residuals of several models (one column each), computed in parallel.
@@ -227,22 +231,10 @@ impl PyInverseRecord {
             .map(|m| model_of(py, m).map(|m| (*m).clone()))
             .collect::<PyResult<Vec<_>>>()?;
         let n = self.rec.len();
-        let q = ms.len();
-        let flat = py
-            .detach(|| -> Result<Vec<f64>, Error> {
-                let rs = self.rec.residuals(&ms)?;
-                let mut flat = vec![0.0; n * q];
-                for (j, c) in rs.iter().enumerate() {
-                    for (k, &x) in c.iter().enumerate() {
-                        flat[k * q + j] = x;
-                    }
-                }
-                Ok(flat)
-            })
+        let cols = py
+            .detach(|| self.rec.residuals(&ms))
             .map_err(|e| to_py(py, e))?;
-        let out = Array2::from_shape_vec((n, q), flat)
-            .map_err(|e| to_py(py, Error::input("models", e.to_string())))?;
-        Ok(out.into_pyarray(py))
+        Ok(columns(n, &cols).into_pyarray(py))
     }
 
     /// `(force, J, nonzero)`: the unfiltered LuGre force, its filtered derivatives with
@@ -262,19 +254,8 @@ impl PyInverseRecord {
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| to_py(py, e))?;
         let n = self.rec.len();
-        let q = params.len();
-        let (s, flat) = py.detach(|| {
-            let s = self.rec.base_sensitivities(&m, &params);
-            let mut flat = vec![0.0; n * q];
-            for (j, c) in s.columns.iter().enumerate() {
-                for (k, &x) in c.iter().enumerate() {
-                    flat[k * q + j] = x;
-                }
-            }
-            (s, flat)
-        });
-        let jac = Array2::from_shape_vec((n, q), flat)
-            .map_err(|e| to_py(py, Error::input("names", e.to_string())))?;
+        let s = py.detach(|| self.rec.base_sensitivities(&m, &params));
+        let jac = columns(n, &s.columns);
         Ok((s.force.into_pyarray(py), jac.into_pyarray(py), s.nonzero))
     }
 }
