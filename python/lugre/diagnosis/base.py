@@ -95,7 +95,7 @@ def apply_base(model: Model, values: dict[str, float]) -> Model:
     return Model(d)
 
 
-def base_jacobian(model: Model, sig: Signals, fr0: np.ndarray | None = None,
+def base_jacobian(model: Model, sig: Signals,
                   names: tuple[str, ...] | list[str] | None = None
                   ) -> tuple[np.ndarray, list[str], np.ndarray, np.ndarray]:
     """Jacobian of the filtered model force with respect to the base parameters.
@@ -110,8 +110,6 @@ def base_jacobian(model: Model, sig: Signals, fr0: np.ndarray | None = None,
         The model at which to linearise (its effects included).
     sig : Signals
         The prepared recording.
-    fr0 : numpy.ndarray, optional
-        Unused (kept for callers that pass ``base_friction(model, sig)``).
     names : sequence of str, optional
         The parameters to linearise in (default :data:`LEVELS`).
 
@@ -126,7 +124,6 @@ def base_jacobian(model: Model, sig: Signals, fr0: np.ndarray | None = None,
     tol : numpy.ndarray
         Prior standard deviations (absolute).
     """
-    del fr0
     wanted = set(LEVELS if names is None else names)
     fr = model.friction
     order: list[str] = []

@@ -186,7 +186,7 @@ def diagnose(
     # 2. the base: friction levels always; the presliding pair only when the record
     #    shows it (held-out profile test); the mass as a base parameter only when asked
     wanted = B.LEVELS + B.PRESLIDING + (("mass",) if free_mass else ())
-    J, names, _, tol = B.base_jacobian(model, sig, fr0, names=wanted)
+    J, names, _, tol = B.base_jacobian(model, sig, names=wanted)
     tol = tol * float(tolerance)
     held = [k for k, n in enumerate(names) if n not in B.PRESLIDING]
     noise = R.noise_floor(r0, sig)
