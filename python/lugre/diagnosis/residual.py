@@ -417,7 +417,7 @@ def noise_floor(r: np.ndarray, sig: Signals) -> dict[str, float]:
     nper = int(min(n, max(256, 2 ** int(np.log2(max(n // 8, 256))))))
     f, p = signal.welch(y, fs=sig.fs, nperseg=nper)
     fc = sig.cutoff_hz
-    sos = signal.butter(4, fc / (0.5 * sig.fs), output="sos")
+    sos = _butter(4, fc / (0.5 * sig.fs))
     _, h = signal.sosfreqz(sos, worN=f, fs=sig.fs)
     h2 = np.abs(h) ** 4  # filtfilt: squared magnitude, squared again for power
     band = (f >= 0.25 * fc) & (f <= 0.9 * fc)
