@@ -510,6 +510,20 @@ def diagnosis_page(report: dict[str, Any], data: dict[str, Any] | None = None, *
     else:
         body.append(_p("None moved by more than 0.5 %."))
 
+    minor = report.get("minor")
+    if isinstance(minor, list) and minor:
+        body.append("<h2>Minor corrections</h2>")
+        body.append(_p("Consistent on the held-out stretches, but each under 0.3 % of the "
+                       "motor force: kept in the augmented model so that they do not bend "
+                       "the findings, too small to name as missing physics."))
+        rows = [[escape(_effect_title(str(m.get("effect")))),
+                 escape(", ".join(f"{k} {v:.4g}" if isinstance(v, (int, float)) else f"{k} {v}"
+                                  for k, v in (m.get("parameters") or {}).items()
+                                  if not isinstance(v, list))),
+                 escape(U.fmt(m.get("rms_force"), ("N", 1.0)))]
+                for m in minor if isinstance(m, dict)]
+        body.append(_table(["effect", "parameters", "rms force"], rows, {2}))
+
     body.append("<h2>What this record could not have revealed</h2>")
     body.append(_could_not_reveal(report))
 

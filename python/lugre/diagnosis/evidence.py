@@ -241,30 +241,82 @@ def base_notes(base: dict[str, dict[str, Any]], findings: list[Any]) -> list[str
     return notes
 
 
-def unexplained(r: np.ndarray, sig: R.Signals, floor: float, where: dict[str, Any],
-                after: dict[str, float]) -> dict[str, Any] | None:
-    """The rest above twice the noise floor: where it lives and what shape it has."""
-    from .locate import short_ranges
-
-    rms1 = after["rms_force"]
-    if rms1 <= 2.0 * floor:
-        return None
-    m = sig.mask
-    rr = r[m]
-    vf = sig.vf[m]
+def reversals(sig: R.Signals, window: float = 0.05) -> tuple[np.ndarray, int]:
+    """Samples within ``window`` seconds of a reversal of the motion (a change of sign
+    of the filtered velocity beyond 2 % of its peak), and the number of reversals."""
+    vf = np.where(sig.mask, sig.vf, 0.0)
     vmax = float(np.max(np.abs(vf)))
     rev = np.zeros(vf.size, dtype=bool)
     s = np.sign(np.where(np.abs(vf) > 0.02 * vmax, vf, 0.0))
     nz = np.flatnonzero(s)
     flips = nz[1:][s[nz[1:]] != s[nz[:-1]]]
-    w = max(int(0.05 * sig.fs), 3)
+    w = max(int(window * sig.fs), 3)
     for j in flips:
         rev[max(j - w, 0):j + w] = True
+    return rev & sig.mask, int(flips.size)
+
+
+def lag_at_reversals(scorer: Scorer, terms: list[Term], k: int, ev: Any,
+                     ctx: Any) -> dict[str, Any] | None:
+    """Is the lag term ``terms[k]`` a time shift of the whole force, or a mismatch at
+    the reversals only?
+
+    A delay or a current lag shifts the motor force everywhere: between reversals too,
+    wherever the force changes (accelerations). Lost motion (backlash between motor
+    and load, a presliding stage the model does not hold) fits a lag at the reversals
+    alone. The lag is refitted, jointly with the base and the other terms, on the
+    samples more than 50 ms from any reversal; when that record determines it (its
+    standard error a quarter of the full fit's lag or less) and it is under half the
+    full fit's, more than four standard errors below, the lag is a reversal mismatch.
+    Returns the figures, or None when the record cannot tell.
+    """
+    sig = ctx.sig
+    rev, nrev = reversals(sig)
+    away = scorer.mask & ~rev
+    if nrev == 0 or away.sum() < 0.2 * scorer.mask.sum():
+        return None
+    q = scorer.J.shape[1]
+    start = q + sum(t.X.shape[1] for t in terms[:k])
+    tau = float(ev.beta[start])
+    x = terms[k].X[:, 0]
+    sxx = float(np.sum(x[away] ** 2))
+    if not (tau > 0 and sxx > 0):
+        return None
+    se = float(np.sqrt(scorer.s2 / sxx))
+    ev2 = Scorer(scorer.r, scorer.J, scorer.tol, away, scorer.s2, scorer.K).evaluate(terms)
+    tau_away = float(ev2.beta[start])
+    return {"lag_s": tau, "lag_away_s": tau_away, "se_s": se, "reversals": nrev,
+            "reversals_only": bool(se < 0.25 * tau and tau_away < 0.5 * tau
+                                   and tau - tau_away > 4.0 * se)}
+
+
+def unexplained(r: np.ndarray, sig: R.Signals, floor: float, where: dict[str, Any],
+                after: dict[str, float], lag_rev: dict[str, Any] | None = None
+                ) -> dict[str, Any] | None:
+    """The rest above twice the noise floor: where it lives and what shape it has
+    (``lag_rev``: a lag that fitted the reversals only, :func:`lag_at_reversals`)."""
+    from .locate import short_ranges
+
+    rms1 = after["rms_force"]
+    if rms1 <= 2.0 * floor and lag_rev is None:
+        return None
+    m = sig.mask
+    rr = r[m]
+    rev_all, nrev = reversals(sig)
+    rev = rev_all[m]
     share_rev = float(np.sum(rr[rev] ** 2) / max(np.sum(rr ** 2), 1e-300))
     shape = []
-    if rev.any() and share_rev > 2.0 * rev.mean() and share_rev > 0.3:
+    if lag_rev is not None:
         shape.append(
-            f"{100 * share_rev:.0f} % of the rest lies within 50 ms of the {flips.size} "
+            f"at the {nrev} reversals the force acts as if {lag_rev['lag_s'] * 1e3:.2g} ms "
+            f"late, between them {lag_rev['lag_away_s'] * 1e3:.2g} ms (+-"
+            f"{2 * lag_rev['se_s'] * 1e3:.2g}): not a delay of the drive, which would shift "
+            "the force everywhere, but lost motion at each change of direction, e.g. "
+            "backlash between motor and load or a presliding stage the model does not "
+            "hold")
+    if lag_rev is None and rev.any() and share_rev > 2.0 * rev.mean() and share_rev > 0.3:
+        shape.append(
+            f"{100 * share_rev:.0f} % of the rest lies within 50 ms of the {nrev} "
             f"reversals ({100 * rev.mean():.0f} % of the time): a force step or lost motion "
             "at each change of direction, e.g. backlash between motor and load, or a "
             "presliding stage the model does not hold")

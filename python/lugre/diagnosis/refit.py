@@ -3,6 +3,7 @@ on the exact residual."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -97,8 +98,7 @@ def refine(model: Model, sig: R.Signals, terms: list[Term], base: dict[str, floa
         for k, t in enumerate(terms):
             h, b = t.cand.recenter(t.h, betas[k], ctx)
             if h is not t.h:
-                terms[k] = Term(cand=t.cand, h=h, X=t.X, prior=t.prior, center=t.center,
-                                profile=t.profile)
+                terms[k] = replace(t, h=h)
                 betas[k] = b
         base = {n: B.get_base(aug, n) for n, _ in B.BASE_PARAMS}
         r = R.residual(aug, sig)

@@ -130,6 +130,10 @@ class Diagnosis:
     base_moves: list[dict[str, Any]] = field(default_factory=list)
     #: the verdict in one paragraph
     verdict: str = ""
+    #: effects consistent on the held-out blocks but under 0.3 % of the motor force:
+    #: kept in the augmented model (so that they do not leak into the findings), not
+    #: named; each ``effect``, ``parameters``, ``rms_force`` [N]
+    minor: list[dict[str, Any]] = field(default_factory=list)
 
     def augmented_model(self) -> Model:
         """The model with the findings added to ``effects`` and the base re-estimated."""
@@ -148,6 +152,7 @@ class Diagnosis:
             "notes": list(self.notes),
             "base_moves": _plain(self.base_moves),
             "could_not_reveal": _plain(self.could_not_reveal),
+            "minor": _plain(self.minor),
             "trials": [
                 {k: _plain(v) for k, v in t.items() if k in (
                     "step", "effect", "gain", "p", "positive", "contrib", "accepted", "why")}
@@ -200,6 +205,12 @@ class Diagnosis:
             for alt in f.alternatives:
                 lines.append(f"   Equally well: {alt['effect']} {_fmt(alt['parameters'])}. "
                              f"To separate: {alt['experiment']}")
+        if self.minor:
+            lines.append(
+                "Minor corrections, consistent on the held-out stretches but each under "
+                "0.3 % of the motor force (kept in the augmented model, too small to name): "
+                + "; ".join(f"{m['effect']} {_fmt({k: v for k, v in m['parameters'].items() if not isinstance(v, list)})} ({m['rms_force']:.2g} N rms)"
+                            for m in self.minor) + ".")
         moved = [f"{n} {100 * b['change']:+.1f} %" for n, b in self.base.items()
                  if abs(b["change"]) > 0.005]
         if moved:
