@@ -181,6 +181,7 @@ def diagnose(
     ctx = E.Context.build(sig, model, fr0)
     lead = screw_lead if screw_lead is not None else model.axis.get("screw_lead")
     ctx.extra["screw_lead"] = float(lead) if lead else None
+    ctx.extra["blocks"] = int(blocks)
     n_used = int(sig.mask.sum())
 
     # 2. the base: friction levels always; the presliding pair only when the record

@@ -324,8 +324,12 @@ class Drift(Candidate):
                  "the direction of motion)")
 
     def _grid(self, ctx: Context) -> np.ndarray:
+        # from a trend that spans two held-out blocks (3 tau = 2 T/K; one that is over
+        # within one block is a start-up transient the other blocks cannot check, and
+        # its column is nearly a rescaling of the friction levels) to 3 T
         T = float(ctx.sig.t[-1] - ctx.sig.t[0])
-        return T * np.logspace(np.log10(1 / 40), np.log10(3.0), 24)
+        K = int(ctx.extra.get("blocks", 10))
+        return T * np.geomspace(2.0 / (3.0 * K), 3.0, 20)
 
     def _col(self, tau: float, ctx: Context) -> np.ndarray:
         return (1.0 - np.exp(-ctx.sig.t / tau)) * ctx.fcs

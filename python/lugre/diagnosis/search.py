@@ -341,6 +341,29 @@ def _profile(scorer: Scorer, kept: list[Term], c: Candidate, grid: np.ndarray, c
     return term, ev
 
 
+#: A term whose contribution, beyond what the base parameters can absorb, has this
+#: share of its energy in one held-out block is not checked by the others.
+_ONE_BLOCK = 0.8
+
+
+def _one_block(scorer: Scorer, contrib: np.ndarray) -> int | None:
+    """The block holding over :data:`_ONE_BLOCK` of a contribution's energy once the
+    base columns are projected out, or None."""
+    Q = scorer.__dict__.get("_Q")
+    if Q is None:
+        J = scorer.J[scorer.idx]
+        Q = scorer.__dict__["_Q"] = (np.linalg.qr(J)[0] if J.shape[1]
+                                     else np.zeros((J.shape[0], 0)))
+    c = contrib[scorer.idx]
+    cp = c - Q @ (Q.T @ c)
+    e = np.array([float(cp[b] @ cp[b]) for b in scorer.blocks])
+    tot = float(e.sum())
+    if not tot > 0:
+        return None
+    k = int(np.argmax(e))
+    return k if e[k] > _ONE_BLOCK * tot else None
+
+
 def compare(cur: Evaluation, new: Evaluation, s2: float) -> dict[str, float]:
     """Held-out evidence of ``new`` against ``cur``.
 
@@ -480,6 +503,15 @@ def forward_select(
             if ok and c.effect == "delay" and beta[0] < 0.2 * dt:
                 ok, why = False, (f"lag of {beta[0] * 1e3:.3g} ms is below a fifth of the "
                                   "sample interval: a timing detail of the sampled record")
+            if ok:
+                one = _one_block(scorer, term.X @ beta)
+                if one is not None:
+                    t0, t1 = ctx.sig.t[scorer.idx[scorer.blocks[one]][[0, -1]]]
+                    ok, why = False, (
+                        f"{100 * _ONE_BLOCK:.0f} % or more of what it adds to the friction "
+                        f"levels lives in one held-out stretch ({t0:.3g} to {t1:.3g} s): "
+                        "the other stretches cannot check it (a start-up transient or a "
+                        "single event looks like this)")
             if ok and contrib < min_effect * noise_rms:
                 ok, why = False, "contribution small against the noise floor"
             if ok and contrib < min_force and c.effect != "delay":
