@@ -309,3 +309,71 @@ fn breakdown_at_thirty_percent_gross_errors() {
         "{broken} of {n_sets} broke down"
     );
 }
+
+/// Many points (FAST-LTS): the starts on a subsample of 400 points per direction, then
+/// the best paths on all points, give the fit whose starts ran on every point (same
+/// points rejected, parameters a tiny fraction of a standard error apart), with 12 %
+/// symmetric gross errors in one direction and 55 % one-sided in the other (more
+/// than half: the trimmed fits' held scale is carried to all points).
+#[test]
+fn many_points_subsampled_starts_match_all_points() {
+    use lugre::friction::StaticSet;
+    let pos = StaticSet::new(28.7, 60.2, 332.5, 0.01).unwrap();
+    let neg = StaticSet::new(28.5, 60.1, 333.0, 0.01).unwrap();
+    let n = 1000;
+    let mut rng = Rng(5);
+    let (mut v, mut f) = (Vec::new(), Vec::new());
+    for (sign, set, share, one_sided) in [(1.0, &pos, 0.12, false), (-1.0, &neg, 0.55, true)] {
+        for k in 0..n {
+            let s = sign * 2e-4 * 2000f64.powf(k as f64 / (n - 1) as f64);
+            let mut ff = set.stribeck(s) + 0.3 * rng.normal();
+            if rng.uniform() < share {
+                let dir = if one_sided || rng.uniform() < 0.5 {
+                    1.0
+                } else {
+                    -1.0
+                };
+                ff *= 1.0 + dir * (0.1 + 0.3 * rng.uniform());
+            }
+            v.push(s);
+            f.push(ff);
+        }
+    }
+    let sub = fit_static(&v, &f, &StaticFitOptions::default()).unwrap();
+    let all_opts = StaticFitOptions {
+        max_start_points: usize::MAX,
+        ..Default::default()
+    };
+    let all = fit_static(&v, &f, &all_opts).unwrap();
+    assert_eq!(sub.rejected, all.rejected);
+    for (a, b, t) in [
+        (&sub.positive, &all.positive, &pos),
+        (&sub.negative, &all.negative, &neg),
+    ] {
+        let (pa, pb, pt) = (
+            [a.set.fc, a.set.fs, a.set.sigma2, a.set.vs],
+            [b.set.fc, b.set.fs, b.set.sigma2, b.set.vs],
+            [t.fc, t.fs, t.sigma2, t.vs],
+        );
+        for k in 0..4 {
+            assert!(
+                (pa[k] - pb[k]).abs() < 1e-2 * b.std_err[k],
+                "{k}: {pa:?} {pb:?} {:?}",
+                b.std_err
+            );
+            assert!((pa[k] / pt[k] - 1.0).abs() < 0.01, "{pa:?} {pt:?}");
+        }
+    }
+    // at most max_start_points points per direction: the starts on every point
+    let at = StaticFitOptions {
+        max_start_points: n,
+        ..Default::default()
+    };
+    assert_eq!(fit_static(&v, &f, &at).unwrap(), all);
+    let few = StaticFitOptions {
+        max_start_points: 4,
+        ..Default::default()
+    };
+    let e = fit_static(&v, &f, &few).unwrap_err();
+    assert!(e.to_string().contains("max_start_points"), "{e}");
+}

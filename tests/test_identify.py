@@ -25,6 +25,35 @@ def truth_sets() -> dict[str, dict[str, float]]:
                 "vs": p[f"vs_{s}"]} for d, s in (("positive", "p"), ("negative", "n"))}
 
 
+def test_static_many_points_match_the_starts_on_every_point():
+    """3000 points per direction: the starts on a subsample of 400 per direction and the
+    best paths finished on all points give the fit whose starts ran on every point (the
+    same points rejected, parameters within a hundredth of a standard error), also for
+    a direction with more than half gross errors (one-sided); at most
+    ``max_start_points`` points the starts run on every point (the same fit)."""
+    rng = np.random.default_rng(3)
+    m = lugre.Model.paper()
+    s = np.geomspace(2e-4, 0.4, 3000)
+    v = np.concatenate([s, -s])
+    F = lugre.stribeck(v, m) + 0.3 * rng.standard_normal(v.size)
+    pos = (v > 0) & (rng.uniform(size=v.size) < 0.3)
+    neg = (v < 0) & (rng.uniform(size=v.size) < 0.55)
+    F[pos] *= 1 + rng.choice([-1.0, 1.0], pos.sum()) * rng.uniform(0.1, 0.4, pos.sum())
+    F[neg] *= 1 + rng.uniform(0.1, 0.4, neg.sum())
+    sub = lugre.fit_static(v, F)
+    every = lugre.fit_static(v, F, max_start_points=sys.maxsize)
+    assert sub.rejected == every.rejected
+    for d in ("positive", "negative"):
+        a, b = getattr(sub, d), getattr(every, d)
+        for k, t in getattr(m, d).items():
+            assert abs(a.params[k] - b.params[k]) < 1e-2 * b.std_err[k], (d, k)
+            assert a.params[k] == pytest.approx(t, rel=0.01), (d, k)
+    at = lugre.fit_static(v, F, max_start_points=3000)
+    for d in ("positive", "negative"):
+        assert getattr(at, d).params == getattr(every, d).params
+        np.testing.assert_array_equal(getattr(at, d).weights, getattr(every, d).weights)
+
+
 @needs_static
 def test_static_points_with_gross_errors():
     """paper_axis_points.csv (about 12 % gross errors): fc, fs, sigma2 within 1 % and vs

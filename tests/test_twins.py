@@ -667,6 +667,31 @@ def test_fit_static_twins_generated(n, fc, hump, sigma2, log_vs, noise, n_gross,
     assert_same_static(a, b, rel=1e-6)
 
 
+def _many_points(n, seed=5):
+    """``n`` log-spaced speeds per direction, 0.3 N noise; 12 % symmetric gross errors
+    for ``v > 0``, 55 % one-sided (more than half) for ``v < 0``."""
+    rng = np.random.default_rng(seed)
+    s = np.geomspace(2e-4, 0.4, n)
+    v = np.concatenate([s, -s])
+    F = lugre.stribeck(v, lugre.Model.paper()) + 0.3 * rng.standard_normal(v.size)
+    pos = (v > 0) & (rng.uniform(size=v.size) < 0.12)
+    neg = (v < 0) & (rng.uniform(size=v.size) < 0.55)
+    F[pos] *= 1 + rng.choice([-1.0, 1.0], pos.sum()) * rng.uniform(0.1, 0.4, pos.sum())
+    F[neg] *= 1 + rng.uniform(0.1, 0.4, neg.sum())
+    return v, F
+
+
+def test_fit_static_twins_many_points():
+    """3000 points per direction: more than ``max_start_points`` (400), so both fit the
+    starts on the same subsample (the fixed-seed SplitMix64 draw) and finish the best
+    paths on all points; the same tolerance as for the generated sets."""
+    v, F = _many_points(3000)
+    a = lugre.fit_static(v, F)
+    b = ref.fit_static(v, F)
+    assert_same_static(a, b, rel=1e-6)
+    assert 0 < len(a.rejected) < v.size
+
+
 def _points(n=6):
     s = np.geomspace(1e-3, 0.3, n)
     return np.concatenate([s, -s]), np.concatenate([30 + 300 * s, -30 - 300 * s])
@@ -692,6 +717,10 @@ BAD_STATIC = [
     ("scale_floor nan", (V6, F6), {"scale_floor": math.nan}, lugre.ParameterError,
      "parameter scale_floor = NaN is invalid"),
     ("max_iter", (V6, F6), {"max_iter": -1}, OverflowError, "negative int to unsigned"),
+    ("max_start_points", (V6, F6), {"max_start_points": 4}, lugre.ParameterError,
+     "parameter max_start_points = 4 is invalid"),
+    ("max_start_points negative", (V6, F6), {"max_start_points": -1}, OverflowError,
+     "negative int to unsigned"),
 ]
 
 

@@ -114,6 +114,7 @@ def fit_static_points(
     weighting: str = "igg",
     max_iter: int = 20,
     scale_floor: float = 0.0,
+    max_start_points: int = 400,
 ) -> dict[str, Any]: ...
 def plateaus(
     t: npt.NDArray[np.float64],

@@ -10,6 +10,9 @@ search over ``ln vs`` (a bracket, then Nelder-Mead). Starts: a Huber grid over
 IRLS with the chosen weights from each (from the trimmed fits at their high-breakdown
 scale held fixed); the kept points refitted by least squares; the path of largest
 Gaussian-plus-uniform mixture likelihood wins; covariance from the weighted Jacobian.
+A direction with more than ``max_start_points`` points (FAST-LTS): the starts and the
+paths on a subsample spread over the speeds (fixed-seed SplitMix64), the best two
+distinct paths once more on all points, the larger likelihood on all points wins.
 
 The operations follow the Rust code in the same order. Where the core's order is that
 of an unstable selection (the subsets of the trimmed fits), sums may be taken in
@@ -40,6 +43,8 @@ LTS_CANDIDATES = 4
 SEEDS_PER_NODE = 36
 LTS_REWEIGHT_CUT = 2.5
 REFIT_REJECT_MIN = 4.685
+MAX_START_POINTS = 400
+FINISHED_PATHS = 2
 _exp = math.exp
 _MASK = 0xFFFF_FFFF_FFFF_FFFF
 
@@ -296,26 +301,53 @@ def _elemental_seeds(a: list[float], count: int) -> list[list[int]]:
     """Three-point subsets, one from each third of the speed range, from the core's
     fixed-seed SplitMix64."""
     n = len(a)
-    by_speed = sorted(range(n), key=lambda i: a[i])
-    state = 0x2545_F491_4F6C_DD1D
-
-    def nxt(m: int) -> int:
-        nonlocal state
-        state = (state + 0x9E37_79B9_7F4A_7C15) & _MASK
-        z = state
-        z = ((z ^ (z >> 30)) * 0xBF58_476D_1CE4_E5B9) & _MASK
-        z = ((z ^ (z >> 27)) * 0x94D0_49BB_1331_11EB) & _MASK
-        return (z ^ (z >> 31)) % max(m, 1)
-
+    by_speed = _by_speed(a)
+    rng = _SplitMix64(0x2545_F491_4F6C_DD1D)
     t1, t2 = n // 3, (2 * n) // 3
     out: list[list[int]] = []
     if t1 == 0 or t2 == t1:
         return out
     while len(out) < count:
-        i = by_speed[nxt(t1)]
-        j = by_speed[t1 + nxt(t2 - t1)]
-        k = by_speed[t2 + nxt(n - t2)]
+        i = by_speed[rng.below(t1)]
+        j = by_speed[t1 + rng.below(t2 - t1)]
+        k = by_speed[t2 + rng.below(n - t2)]
         out.append([i, j, k])
+    return out
+
+
+def _by_speed(a: list[float]) -> list[int]:
+    """Indices in order of speed (stable: equal speeds in input order)."""
+    return sorted(range(len(a)), key=lambda i: a[i])
+
+
+class _SplitMix64:
+    """The core's fixed-seed SplitMix64."""
+
+    def __init__(self, state: int) -> None:
+        self.state = state
+
+    def below(self, m: int) -> int:
+        self.state = (self.state + 0x9E37_79B9_7F4A_7C15) & _MASK
+        z = self.state
+        z = ((z ^ (z >> 30)) * 0xBF58_476D_1CE4_E5B9) & _MASK
+        z = ((z ^ (z >> 27)) * 0x94D0_49BB_1331_11EB) & _MASK
+        return (z ^ (z >> 31)) % max(m, 1)
+
+
+def _subsample(a: list[float], m: int) -> list[int]:
+    """``m`` of the points spread over the speeds (``subsample``): the points in order of
+    speed cut into ``m`` runs, one drawn from each by the fixed-seed generator; in input
+    order."""
+    n = len(a)
+    if m >= n:
+        return list(range(n))
+    by_speed = _by_speed(a)
+    rng = _SplitMix64(0x5DEE_CE66_D1CE_5EED)
+    out = []
+    for j in range(m):
+        lo, hi = j * n // m, (j + 1) * n // m
+        out.append(by_speed[lo + rng.below(hi - lo)])
+    out.sort()
     return out
 
 
@@ -486,6 +518,12 @@ def _lts_scale(e: list[float], h: int) -> float:
     for x in r2[:h]:
         total += x
     s = math.sqrt(total / dof / _truncated_variance(0.5 * (lo + hi)))
+    return _reweight_scale(r2, s)
+
+
+def _reweight_scale(r2: list[float], s: float) -> float:
+    """Twice, the points within 2.5 scales give the scale on ``kept - 4`` (``r2``
+    sorted)."""
     if s == 0.0:
         return s
     for _ in range(2):
@@ -503,6 +541,15 @@ def _lts_scale(e: list[float], h: int) -> float:
             total += x
         s = math.sqrt(total / (len(kept) - 4) / _truncated_variance(LTS_REWEIGHT_CUT))
     return s
+
+
+def _rescale(e: list[float], s: float) -> float:
+    """The scale of all points' residuals at a subsample's fit, reweighted from the
+    path's own scale ``s`` (``rescale``)."""
+    r2 = [x * x for x in e]
+    r2 = [x for x in r2 if not math.isnan(x)]
+    r2.sort()
+    return _reweight_scale(r2, s)
 
 
 def _fmax(a: float, b: float) -> float:
@@ -715,34 +762,40 @@ def _covariance(a: list[float], weights: list[float], residuals: list[float],
 # ---- one direction, both directions (mod.rs) ---------------------------------------------
 
 
-def _fit_direction(a: list[float], y: list[float], sign: float, indices: list[int],
-                   weighting: Weighting, max_iter: int, scale_floor: float,
-                   notes: list[str], label: str) -> dict[str, Any]:
-    fscale = max(median([abs(v) for v in y]), 1e-12)
-    sep = _Sep(a, y, fscale)
-    floor = max(scale_floor, 1e-6 * fscale)
-    cfg = _Cfg(max_iter, 1e-7, floor, 4000)
-    reject_at = weighting.rejects_at
+class _Paths:
+    """The settings of one direction's paths (``Paths`` in mod.rs)."""
 
-    def path(p0: P4, pre: Weighting | None, fixed: float | None = None) -> _Outcome:
+    def __init__(self, cfg: _Cfg, weighting: Weighting, scale_floor: float) -> None:
+        self.cfg, self.weighting, self.scale_floor = cfg, weighting, scale_floor
+        self.reject_at = weighting.rejects_at
+
+    def run(self, sep: _Sep, p0: P4, pre: Weighting | None,
+            fixed: float | None = None) -> _Outcome:
+        """From a start: an optional IRLS pass, IRLS, the refit of the kept points."""
         evals = 0
+        cfg = self.cfg
         if pre is not None:
             o = _irls_vp(sep, p0, pre, cfg, "pre", fixed)
             p0, evals = o.p, o.evals
-        refit = reject_at is not None
-        out = _irls_vp(sep, p0, weighting, cfg, "refit" if refit else "polish", fixed)
+        refit = self.reject_at is not None
+        out = _irls_vp(sep, p0, self.weighting, cfg, "refit" if refit else "polish", fixed)
         out.evals += evals
-        if reject_at is not None:
-            _refit_kept(sep, out, max(reject_at, REFIT_REJECT_MIN), cfg)
+        if self.reject_at is not None:
+            _refit_kept(sep, out, max(self.reject_at, REFIT_REJECT_MIN), cfg)
         return out
 
-    huber_start = _clamp_start(_start_values_huber(sep), a, fscale)
-    if reject_at is not None:
+    def ranked(self, sep: _Sep, fscale: float) -> list[tuple[_Outcome, bool]]:
+        """The paths from the starts on ``sep``'s points, each with whether it held its
+        scale (else the MAD), best first (first of equal costs)."""
+        a, y, cfg = sep.a, sep.y, self.cfg
+        huber_start = _clamp_start(_start_values_huber(sep), a, fscale)
+        if self.reject_at is None:
+            return [(self.run(sep, huber_start, None), False)]
         # seven starts as in MM-estimation: a Huber pass from the Huber grid (MAD
         # scale); from the two best trimmed fits of each subset size a Tukey pass and
-        # IGG at the trimmed fit's scale held fixed; the largest likelihood of a
-        # Gaussian-plus-uniform mixture (each path at its own refit scale) wins
-        paths = [path(huber_start, Weighting.huber())]
+        # IGG at the trimmed fit's scale held fixed
+        paths: list[tuple[_Outcome, bool]] = [
+            (self.run(sep, huber_start, Weighting.huber()), False)]
         for h in _lts_sizes(len(a)):
             refined = [_refine_lts(sep, _clamp_start(p0, a, fscale), h, cfg.nm_pre,
                                    cfg.obj_floor) for p0 in _start_values_lts(sep, h)]
@@ -751,26 +804,75 @@ def _fit_direction(a: list[float], y: list[float], sign: float, indices: list[in
             for _, p in refined[:2]:
                 p = _clamp_start(p, a, fscale)
                 s = _lts_scale(sep.residuals(p), h)
-                paths.append(path(p, Weighting.tukey(), s if math.isfinite(s) else None))
-        width = _fmax(max(y) - min(y), floor)
+                fixed = s if math.isfinite(s) else None
+                paths.append((self.run(sep, p, Weighting.tukey(), fixed), fixed is not None))
+        width = self.width(y)
+        costs = [self.cost(o, width) for o, _ in paths]
+        # sort_by with total_cmp (stable): NaN above everything
+        order = sorted(range(len(paths)),
+                       key=lambda k: (math.isnan(costs[k]), 0.0 if math.isnan(costs[k])
+                                      else costs[k]))
+        return [paths[k] for k in order]
+
+    def width(self, y: list[float]) -> float:
+        return _fmax(max(y) - min(y), self.scale_floor)
+
+    def cost(self, o: _Outcome, width: float) -> float:
+        """The Gaussian-plus-uniform mixture's negative log-likelihood (each path at its
+        own refit scale)."""
         half_ln_2pi_e = 0.5 * (1.0 + math.log(2.0 * math.pi))
+        kept = float(sum(1 for w in o.weights if w > 0.0))
+        out = len(o.weights) - kept
+        return kept * (_ln(_fmax(o.scale, self.scale_floor)) + half_ln_2pi_e) + out * _ln(width)
 
-        def cost(o: _Outcome) -> float:
-            kept = float(sum(1 for w in o.weights if w > 0.0))
-            out = len(o.weights) - kept
-            return kept * (_ln(_fmax(o.scale, floor)) + half_ln_2pi_e) + out * _ln(width)
 
-        evals = sum(o.evals for o in paths)
-        costs = [cost(o) for o in paths]
+def _fit_direction(a: list[float], y: list[float], sign: float, indices: list[int],
+                   weighting: Weighting, max_iter: int, scale_floor: float,
+                   max_start_points: int, notes: list[str], label: str) -> dict[str, Any]:
+    fscale = max(median([abs(v) for v in y]), 1e-12)
+    floor = max(scale_floor, 1e-6 * fscale)
+    cfg = _Cfg(max_iter, 1e-7, floor, 4000)
+    paths = _Paths(cfg, weighting, floor)
+    n = len(a)
+    if n > max_start_points:
+        # FAST-LTS: the starts and their paths on a subsample spread over the speeds,
+        # the best distinct ones (kept sets) once more on all points at their kind of
+        # scale (the MAD, or held: all points' scale reweighted from the path's own),
+        # the smallest cost on all points wins
+        sub = _subsample(a, max_start_points)
+        ranked = paths.ranked(_Sep([a[i] for i in sub], [y[i] for i in sub], fscale), fscale)
+        evals = sum(o.evals for o, _ in ranked)
+        sep = _Sep(a, y, fscale)
+        kept_sets: list[list[bool]] = []
+        finished: list[_Outcome] = []
+        for o, held in ranked:
+            kept = [w > 0.0 for w in o.weights]
+            if kept in kept_sets:
+                continue
+            kept_sets.append(kept)
+            p0 = _clamp_start(o.p, a, fscale)
+            fixed = None
+            if held:
+                s = _rescale(sep.residuals(p0), o.scale)
+                fixed = s if math.isfinite(s) and s > 0.0 else None
+            f = paths.run(sep, p0, None, fixed)
+            evals += f.evals
+            finished.append(f)
+            if len(finished) == FINISHED_PATHS:
+                break
+        width = paths.width(y)
+        costs = [paths.cost(o, width) for o in finished]
         best = 0
-        for k in range(1, len(paths)):
+        for k in range(1, len(finished)):
             # min_by with total_cmp: the first of equal costs, NaN above everything
             if costs[k] < costs[best] or (math.isnan(costs[best]) and not math.isnan(costs[k])):
                 best = k
-        out = paths[best]
-        out.evals = evals
+        out = finished[best]
     else:
-        out = path(huber_start, None)
+        ranked = paths.ranked(_Sep(a, y, fscale), fscale)
+        evals = sum(o.evals for o, _ in ranked)
+        out = ranked[0][0]
+    out.evals = evals
     if not all(math.isfinite(v) for v in out.p):
         raise DataError(
             f"data: {label} direction: the Stribeck curve could not be evaluated at the "
@@ -832,7 +934,7 @@ def _usize(value: Any) -> int:
 
 
 def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
-               scale_floor: float = 0.0) -> StaticFit:
+               scale_floor: float = 0.0, max_start_points: int = MAX_START_POINTS) -> StaticFit:
     """Robust Stribeck fit of steady-state points, per direction (NumPy twin of
     :func:`lugre.fit_static`; same parameters, result, warnings and errors).
 
@@ -848,6 +950,9 @@ def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
         IRLS iterations at most.
     scale_floor : float
         Lower bound of the residual scale [N] (e.g. the force resolution).
+    max_start_points : int
+        Most points of a direction on which the robust starts are searched; more are
+        fitted from a subsample first (FAST-LTS).
 
     Returns
     -------
@@ -860,12 +965,13 @@ def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
     InputError
         NaN or inf, lengths differ, empty input, unknown weighting.
     ParameterError
-        ``scale_floor`` negative or not finite.
+        ``scale_floor`` negative or not finite, ``max_start_points`` below 5.
     """
     va = _as_points("v", v).tolist()
     fa = _as_points("F", F).tolist()
     wname = str(weighting)
     iters = _usize(max_iter)
+    start_points = _usize(max_start_points)
     floor = float(scale_floor)
     wt = Weighting.from_name(wname)
     # the core's checks in the core's order (static_fit/mod.rs, fit_static)
@@ -878,6 +984,9 @@ def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
     _check_finite("f", fa)
     if not (floor >= 0.0 and math.isfinite(floor)):
         raise ParameterError.invalid("scale_floor", floor, "must be finite and zero or greater")
+    if start_points < MIN_POINTS_PER_DIRECTION:
+        raise ParameterError.invalid("max_start_points", float(start_points),
+                                     "must be at least 5 (the points a direction needs)")
     n_zero = sum(1 for x in va if x == 0.0)
     if n_zero == len(va):
         raise DataError("data: every speed is zero: the Stribeck curve needs "
@@ -905,8 +1014,10 @@ def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
                             f"{MIN_POINTS_PER_DIRECTION} are needed for the 4 Stribeck "
                             "parameters; add constant-velocity runs in that direction")
     notes: list[str] = []
-    pos = _fit_direction(ap, yp, 1.0, ip, wt, iters, floor, notes, "positive")
-    neg = _fit_direction(an, yn, -1.0, in_, wt, iters, floor, notes, "negative")
+    pos = _fit_direction(ap, yp, 1.0, ip, wt, iters, floor, start_points, notes,
+                         "positive")
+    neg = _fit_direction(an, yn, -1.0, in_, wt, iters, floor, start_points, notes,
+                         "negative")
     weights = np.zeros(len(va))
     for d in (pos, neg):
         weights[d["indices"]] = d["weights"]

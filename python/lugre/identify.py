@@ -141,7 +141,7 @@ class StaticFit:
 
 
 def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
-               scale_floor: float = 0.0) -> StaticFit:
+               scale_floor: float = 0.0, max_start_points: int = 400) -> StaticFit:
     """Robust Stribeck fit of steady-state points, per direction.
 
     Parameters
@@ -156,6 +156,12 @@ def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
         IRLS iterations at most.
     scale_floor : float
         Lower bound of the residual scale [N] (e.g. the force resolution).
+    max_start_points : int
+        Most points of a direction on which the robust starts are searched. A
+        direction with more points is fitted as least trimmed squares is for large
+        samples (FAST-LTS): the starts on a subsample of this many points spread over
+        the speeds (the same in every run), then the best two paths once more on all
+        points. At least 5; ``sys.maxsize`` for the starts on every point.
 
     Returns
     -------
@@ -167,6 +173,8 @@ def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
         Fewer than 5 points in a direction, one direction only, only zero speeds.
     InputError
         NaN or inf, lengths differ, empty input.
+    ParameterError
+        ``scale_floor`` negative or not finite, ``max_start_points`` below 5.
 
     Examples
     --------
@@ -178,7 +186,7 @@ def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
     60.2
     """
     r = _core.fit_static_points(_array("v", v), _array("F", F), str(weighting),
-                                int(max_iter), float(scale_floor))
+                                int(max_iter), float(scale_floor), int(max_start_points))
     fit = StaticFit(
         positive=DirectionFit._from_core(r["positive"]),
         negative=DirectionFit._from_core(r["negative"]),

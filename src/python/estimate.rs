@@ -35,7 +35,7 @@ fn direction<'py>(py: Python<'py>, d: DirectionFit) -> PyResult<Bound<'py, PyDic
 
 /// Robust per-direction Stribeck fit of steady-state points; returns a dict.
 #[pyfunction]
-#[pyo3(signature = (v, f, weighting="igg", max_iter=20, scale_floor=0.0))]
+#[pyo3(signature = (v, f, weighting="igg", max_iter=20, scale_floor=0.0, max_start_points=400))]
 pub(crate) fn fit_static_points<'py>(
     py: Python<'py>,
     v: PyReadonlyArray1<'py, f64>,
@@ -43,12 +43,14 @@ pub(crate) fn fit_static_points<'py>(
     weighting: &str,
     max_iter: usize,
     scale_floor: f64,
+    max_start_points: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let r = (|| -> Result<_, Error> {
         let opts = StaticFitOptions {
             weighting: Weighting::from_name(weighting)?,
             max_iter,
             scale_floor,
+            max_start_points,
             ..StaticFitOptions::default()
         };
         let (v, f) = (slice("v", &v)?, slice("F", &f)?);

@@ -24,6 +24,18 @@
 //! down-weighting band costs, and the path with the largest likelihood of a
 //! Gaussian-plus-uniform mixture is returned.
 //!
+//! A direction with more than [`StaticFitOptions::max_start_points`] points (400 by
+//! default) is fitted as FAST-LTS fits large samples (Rousseeuw and Van Driessen
+//! 2006): the starts, their paths and their ranking on a subsample of that many points
+//! spread over the speeds (one from each run of the speed ranks, drawn by a fixed-seed
+//! generator, `starts::subsample`); the best two distinct paths (kept sets) once
+//! more on all points from their subsample answers, without the pre-pass, at their
+//! kind of scale (the MAD, or held: all points' scale reweighted from the path's own,
+//! `starts::rescale`); of those the one of the larger mixture likelihood on all
+//! points. The starts cost `O(n)` per concentration step and grid node; this way only
+//! a few IRLS paths see all points (20 000 points: 1 s before, about 70 ms). Up to
+//! `max_start_points` points per direction the fit is the one described above.
+//!
 //! One idea per file: [`varpro`] the separable problem for fixed weights,
 //! [`reweight`] IRLS and the refit of the kept points, [`starts`] the robust starts
 //! (Huber grid, least trimmed squares), [`intervals`] the covariance; this file the
@@ -39,12 +51,22 @@ use super::robust::{median, t_quantile_975, Weighting};
 use crate::error::{check_finite, check_len, Error, Result};
 use crate::friction::StaticSet;
 use reweight::{irls_vp, refit_kept, Cfg, Outcome, Stage};
-use starts::{clamp_start, lts_scale, lts_sizes, refine_lts, start_values_huber, start_values_lts};
+use starts::{
+    clamp_start, lts_scale, lts_sizes, refine_lts, rescale, start_values_huber, start_values_lts,
+    subsample,
+};
 use varpro::Sep;
 
 /// Fewest nonzero-speed points per direction that [`fit_static`] accepts (4 parameters
 /// plus one degree of freedom for the residual scale).
 pub const MIN_POINTS_PER_DIRECTION: usize = 5;
+
+/// Default of [`StaticFitOptions::max_start_points`].
+pub const DEFAULT_MAX_START_POINTS: usize = 400;
+
+/// Paths finished on all points when the starts ran on a subsample
+/// ([`StaticFitOptions::max_start_points`]).
+const FINISHED_PATHS: usize = 2;
 
 /// Names of the static parameters in the order of the per-parameter vectors.
 pub const STATIC_PARAM_NAMES: [&str; 4] = ["fc", "fs", "sigma2", "vs"];
@@ -69,6 +91,13 @@ pub struct StaticFitOptions {
     /// and repeat until the kept set settles (true by default). The down-weighting band
     /// of IGG costs efficiency on clean Gaussian points; this recovers it.
     pub refit_kept: bool,
+    /// Most points of a direction on which the starts are searched (400 by default;
+    /// at least [`MIN_POINTS_PER_DIRECTION`]). A direction with more points is fitted
+    /// as least trimmed squares is for large samples (FAST-LTS, Rousseeuw and Van
+    /// Driessen 2006): the starts and their paths on a subsample of this many points
+    /// spread over the speeds (the same in every run), then the best two once more on
+    /// all points. `usize::MAX`: the starts on all points always.
+    pub max_start_points: usize,
 }
 
 impl Default for StaticFitOptions {
@@ -80,6 +109,7 @@ impl Default for StaticFitOptions {
             scale_floor: 0.0,
             max_evals: 4000,
             refit_kept: true,
+            max_start_points: DEFAULT_MAX_START_POINTS,
         }
     }
 }
@@ -136,6 +166,138 @@ pub struct StaticFit {
     pub notes: Vec<String>,
 }
 
+/// How a path held the residual scale of its weights.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum ScaleRule {
+    /// The MAD of the residuals, recomputed at each IRLS round.
+    Mad,
+    /// A scale held fixed (the high-breakdown scale of a trimmed fit).
+    Held,
+}
+
+/// The settings of one direction's paths (from a start to an answer).
+struct Paths<'c> {
+    cfg: &'c Cfg,
+    weighting: Weighting,
+    /// A rejecting weight function (IGG, Tukey): the robust starts are followed.
+    rejects: bool,
+    /// Rejecting weights with the refit of the kept points: its rejection threshold.
+    refit_at: Option<f64>,
+    scale_floor: f64,
+}
+
+impl Paths<'_> {
+    /// One path: from a start, an optional IRLS pass with another weight function,
+    /// IRLS, then (rejecting weight functions) the least-squares refit on the kept
+    /// points. `fixed`: the residual scale held through both IRLS runs (an
+    /// MM-estimate's M-step) instead of the MAD recomputed at each round.
+    fn run(
+        &self,
+        sep: &mut Sep,
+        p0: [f64; 4],
+        pre: Option<Weighting>,
+        fixed: Option<f64>,
+    ) -> Outcome {
+        let cfg = self.cfg;
+        let mut p0 = p0;
+        let mut evals = 0;
+        if let Some(w) = pre {
+            let o = irls_vp(sep, p0, w, cfg, Stage::Pre, fixed);
+            p0 = o.p;
+            evals = o.evals;
+        }
+        let stage = if self.refit_at.is_some() {
+            Stage::Refit
+        } else {
+            Stage::Polish
+        };
+        let mut out = irls_vp(sep, p0, self.weighting, cfg, stage, fixed);
+        out.evals += evals;
+        if let Some(k) = self.refit_at {
+            refit_kept(sep, &mut out, k, cfg);
+        }
+        out
+    }
+
+    /// The starts on all of `sep`'s points and the path from each, each with the kind
+    /// of scale it held, best first ([`Paths::cost`]; of equal costs the earlier path).
+    fn ranked(&self, sep: &mut Sep, fscale: f64) -> Vec<(Outcome, ScaleRule)> {
+        let (a, y) = (sep.a, sep.y);
+        let huber_start = clamp_start(start_values_huber(sep), a, fscale);
+        if !self.rejects {
+            return vec![(self.run(sep, huber_start, None, None), ScaleRule::Mad)];
+        }
+        // Redescending weights (IGG, Tukey) settle on the set of rejected points near
+        // their start. Seven starts, as in MM-estimation (Yohai 1987): (a) a Huber pass
+        // (monotone, unique fixed point, MAD scale) from the Huber grid; (b)-(d) the two
+        // best fits of least trimmed squares on half, three quarters and two fifths of
+        // the points (grid, then `vs` freed, [`lts_sizes`]), which also resist gross
+        // errors of high leverage (the fastest and slowest points) that a Huber fit
+        // follows, each followed by a Tukey pass and IGG at the trimmed fit's
+        // high-breakdown scale held fixed ([`lts_scale`]).
+        let mut paths = vec![(
+            self.run(sep, huber_start, Some(Weighting::huber()), None),
+            ScaleRule::Mad,
+        )];
+        let n = a.len();
+        for h in lts_sizes(n) {
+            let mut refined: Vec<(f64, [f64; 4])> = start_values_lts(sep, h)
+                .into_iter()
+                .map(|p0| {
+                    refine_lts(
+                        sep,
+                        clamp_start(Some(p0), a, fscale),
+                        h,
+                        &self.cfg.nm_pre,
+                        self.cfg.obj_floor,
+                    )
+                })
+                .filter(|r| r.0.is_finite())
+                .collect();
+            refined.sort_by(|x, y| x.0.total_cmp(&y.0));
+            for (_, p) in refined.into_iter().take(2) {
+                let p = clamp_start(Some(p), a, fscale);
+                let s = lts_scale(&sep.residuals(&p), h);
+                let fixed = s.is_finite().then_some(s);
+                let rule = match fixed {
+                    Some(_) => ScaleRule::Held,
+                    None => ScaleRule::Mad,
+                };
+                paths.push((self.run(sep, p, Some(Weighting::tukey()), fixed), rule));
+            }
+        }
+        let width = self.width(y);
+        let mut ranked: Vec<(f64, (Outcome, ScaleRule))> = paths
+            .into_iter()
+            .map(|o| (self.cost(&o.0, width), o))
+            .collect();
+        ranked.sort_by(|x, y| x.0.total_cmp(&y.0));
+        ranked.into_iter().map(|x| x.1).collect()
+    }
+
+    /// Range of the forces `y` (at least the scale floor), over which [`Paths::cost`]
+    /// spreads the rejected points.
+    fn width(&self, y: &[f64]) -> f64 {
+        let ymax = y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let ymin = y.iter().copied().fold(f64::INFINITY, f64::min);
+        (ymax - ymin).max(self.scale_floor)
+    }
+
+    /// The choice among the paths (the local minima): the negative log-likelihood of a
+    /// mixture, the kept points Gaussian at the path's own scale (that of its
+    /// least-squares refit), the rejected ones uniform over the range `width` of the
+    /// forces (MLESAC, Torr and Zisserman 2000). A fit to a few points at a small scale
+    /// pays for every clean point it leaves out, a compromise through the gross errors
+    /// for its large scale; no common scale is needed, which a direction with half or
+    /// more gross errors would inflate (the MAD) and a fit to a subset would shrink.
+    fn cost(&self, o: &Outcome, width: f64) -> f64 {
+        let half_ln_2pi_e = 0.5 * (1.0 + (2.0 * std::f64::consts::PI).ln());
+        let kept = o.weights.iter().filter(|w| **w > 0.0).count() as f64;
+        let out = o.weights.len() as f64 - kept;
+        kept * (o.scale.max(self.scale_floor).ln() + half_ln_2pi_e) + out * width.ln()
+    }
+}
+
 /// Fit one direction to magnitudes `a = |v|` and mirrored forces `y = sign(v)*F`.
 fn fit_direction(
     a: &[f64],
@@ -147,7 +309,6 @@ fn fit_direction(
     label: &str,
 ) -> Result<DirectionFit> {
     let fscale = median(&y.iter().map(|v| v.abs()).collect::<Vec<_>>()).max(1e-12);
-    let mut sep = Sep::new(a, y, fscale);
     let scale_floor = opts.scale_floor.max(1e-6 * fscale);
     let cfg = Cfg {
         max_outer: opts.max_iter,
@@ -178,93 +339,67 @@ fn fit_direction(
         Weighting::Tukey { c } => Some(c),
         _ => None,
     };
-    // One path: from a start, an optional IRLS pass with another weight function,
-    // IRLS, then (rejecting weight functions) the least-squares refit on the kept points.
-    // `fixed`: the residual scale held through both IRLS runs (an MM-estimate's M-step)
-    // instead of the MAD recomputed at each round.
-    let path =
-        |sep: &mut Sep, p0: [f64; 4], pre: Option<Weighting>, fixed: Option<f64>| -> Outcome {
-            let mut p0 = p0;
-            let mut evals = 0;
-            if let Some(w) = pre {
-                let o = irls_vp(sep, p0, w, &cfg, Stage::Pre, fixed);
-                p0 = o.p;
-                evals = o.evals;
+    let paths = Paths {
+        cfg: &cfg,
+        weighting: opts.weighting,
+        rejects: reject_at.is_some(),
+        refit_at: reject_at
+            .filter(|_| opts.refit_kept)
+            .map(|k1| k1.max(reweight::REFIT_REJECT_MIN)),
+        scale_floor,
+    };
+    let n = a.len();
+    let out = if n > opts.max_start_points {
+        // Many points (FAST-LTS, Rousseeuw and Van Driessen 2006): the starts and their
+        // paths on a subsample spread over the speeds; the best [`FINISHED_PATHS`]
+        // distinct ones (kept sets) once more on all points, each from its subsample
+        // answer at its kind of scale (the MAD, or held: the scale of all points there
+        // reweighted from the path's own, [`rescale`]), and of those the one of the
+        // smallest cost on all points.
+        let sub = subsample(a, opts.max_start_points);
+        let a_s: Vec<f64> = sub.iter().map(|&i| a[i]).collect();
+        let y_s: Vec<f64> = sub.iter().map(|&i| y[i]).collect();
+        let ranked = paths.ranked(&mut Sep::new(&a_s, &y_s, fscale), fscale);
+        let mut evals: usize = ranked.iter().map(|o| o.0.evals).sum();
+        let mut sep = Sep::new(a, y, fscale);
+        let mut kept_sets: Vec<Vec<bool>> = Vec::new();
+        let mut finished: Vec<Outcome> = Vec::new();
+        for (o, rule) in ranked {
+            let kept: Vec<bool> = o.weights.iter().map(|w| *w > 0.0).collect();
+            if kept_sets.contains(&kept) {
+                continue;
             }
-            let refit = opts.refit_kept && reject_at.is_some();
-            let stage = if refit { Stage::Refit } else { Stage::Polish };
-            let mut out = irls_vp(sep, p0, opts.weighting, &cfg, stage, fixed);
-            out.evals += evals;
-            if let (true, Some(k1)) = (refit, reject_at) {
-                refit_kept(sep, &mut out, k1.max(reweight::REFIT_REJECT_MIN), &cfg);
-            }
-            out
-        };
-    let huber_start = clamp_start(start_values_huber(&mut sep), a, fscale);
-    let out = if reject_at.is_some() {
-        // Redescending weights (IGG, Tukey) settle on the set of rejected points near
-        // their start. Seven starts, as in MM-estimation (Yohai 1987): (a) a Huber pass
-        // (monotone, unique fixed point, MAD scale) from the Huber grid; (b)-(d) the two
-        // best fits of least trimmed squares on half, three quarters and two fifths of
-        // the points (grid, then `vs` freed, [`lts_sizes`]), which also resist gross
-        // errors of high leverage (the fastest and slowest points) that a Huber fit
-        // follows, each followed by a Tukey pass and IGG at the trimmed fit's
-        // high-breakdown scale held fixed ([`lts_scale`]).
-        let mut paths = vec![path(&mut sep, huber_start, Some(Weighting::huber()), None)];
-        let n = a.len();
-        for h in lts_sizes(n) {
-            let mut refined: Vec<(f64, [f64; 4])> = start_values_lts(&mut sep, h)
-                .into_iter()
-                .map(|p0| {
-                    refine_lts(
-                        &mut sep,
-                        clamp_start(Some(p0), a, fscale),
-                        h,
-                        &cfg.nm_pre,
-                        cfg.obj_floor,
-                    )
-                })
-                .filter(|r| r.0.is_finite())
-                .collect();
-            refined.sort_by(|x, y| x.0.total_cmp(&y.0));
-            for (_, p) in refined.into_iter().take(2) {
-                let p = clamp_start(Some(p), a, fscale);
-                let s = lts_scale(&sep.residuals(&p), h);
-                paths.push(path(
-                    &mut sep,
-                    p,
-                    Some(Weighting::tukey()),
-                    s.is_finite().then_some(s),
-                ));
+            kept_sets.push(kept);
+            let p0 = clamp_start(Some(o.p), a, fscale);
+            let fixed = match rule {
+                ScaleRule::Mad => None,
+                ScaleRule::Held => {
+                    let s = rescale(&sep.residuals(&p0), o.scale);
+                    (s.is_finite() && s > 0.0).then_some(s)
+                }
+            };
+            let f = paths.run(&mut sep, p0, None, fixed);
+            evals += f.evals;
+            finished.push(f);
+            if finished.len() == FINISHED_PATHS {
+                break;
             }
         }
-        // The choice among the paths (the local minima): the likelihood of a mixture,
-        // the kept points Gaussian at the path's own scale (that of its least-squares
-        // refit), the rejected ones uniform over the range of the forces (MLESAC, Torr
-        // and Zisserman 2000). A fit to a few points at a small scale pays for every
-        // clean point it leaves out, a compromise through the gross errors for its
-        // large scale; no common scale is needed, which a direction with half or more
-        // gross errors would inflate (the MAD) and a fit to a subset would shrink.
-        let ymax = y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let ymin = y.iter().copied().fold(f64::INFINITY, f64::min);
-        let width = (ymax - ymin).max(scale_floor);
-        let half_ln_2pi_e = 0.5 * (1.0 + (2.0 * std::f64::consts::PI).ln());
-        let cost = |o: &Outcome| -> f64 {
-            let kept = o.weights.iter().filter(|w| **w > 0.0).count() as f64;
-            let out = o.weights.len() as f64 - kept;
-            kept * (o.scale.max(scale_floor).ln() + half_ln_2pi_e) + out * width.ln()
-        };
-        let evals = paths.iter().map(|o| o.evals).sum();
-        let mut best = paths
+        let width = paths.width(y);
+        let mut best = finished
             .into_iter()
-            .map(|o| (cost(&o), o))
+            .map(|o| (paths.cost(&o, width), o))
             .min_by(|x, y| x.0.total_cmp(&y.0))
             .map(|x| x.1)
-            .expect("at least the Huber path");
+            .expect("at least one path");
         best.evals = evals;
         best
     } else {
-        path(&mut sep, huber_start, None, None)
+        let ranked = paths.ranked(&mut Sep::new(a, y, fscale), fscale);
+        let evals = ranked.iter().map(|o| o.0.evals).sum();
+        let mut best = ranked.into_iter().next().expect("at least one path").0;
+        best.evals = evals;
+        best
     };
     if !out.p.iter().all(|v| v.is_finite()) {
         return Err(Error::Data(format!(
@@ -354,6 +489,13 @@ pub fn fit_static(v: &[f64], f: &[f64], opts: &StaticFitOptions) -> Result<Stati
             "scale_floor",
             opts.scale_floor,
             "must be finite and zero or greater",
+        ));
+    }
+    if opts.max_start_points < MIN_POINTS_PER_DIRECTION {
+        return Err(Error::parameter(
+            "max_start_points",
+            opts.max_start_points as f64,
+            "must be at least 5 (the points a direction needs)",
         ));
     }
     let n_zero = v.iter().filter(|x| **x == 0.0).count();

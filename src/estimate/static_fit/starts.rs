@@ -82,16 +82,8 @@ pub(super) fn start_values_huber(sep: &mut Sep) -> Option<[f64; 4]> {
 /// and the viscous slope.
 pub(super) fn elemental_seeds(a: &[f64], count: usize) -> Vec<[usize; 3]> {
     let n = a.len();
-    let mut by_speed: Vec<usize> = (0..n).collect();
-    by_speed.sort_by(|&i, &j| a[i].total_cmp(&a[j]));
-    let mut state = 0x2545_F491_4F6C_DD1Du64;
-    let mut next = |m: usize| {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) % m.max(1) as u64) as usize
-    };
+    let by_speed = by_speed(a);
+    let mut rng = SplitMix64(0x2545_F491_4F6C_DD1D);
     let (t1, t2) = (n / 3, (2 * n) / 3);
     let mut out = Vec::with_capacity(count);
     if t1 == 0 || t2 == t1 {
@@ -99,11 +91,56 @@ pub(super) fn elemental_seeds(a: &[f64], count: usize) -> Vec<[usize; 3]> {
     }
     while out.len() < count {
         out.push([
-            by_speed[next(t1)],
-            by_speed[t1 + next(t2 - t1)],
-            by_speed[t2 + next(n - t2)],
+            by_speed[rng.below(t1)],
+            by_speed[t1 + rng.below(t2 - t1)],
+            by_speed[t2 + rng.below(n - t2)],
         ]);
     }
+    out
+}
+
+/// Indices of `a` in order of speed (a stable sort: equal speeds in input order).
+fn by_speed(a: &[f64]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..a.len()).collect();
+    order.sort_by(|&i, &j| a[i].total_cmp(&a[j]));
+    order
+}
+
+/// SplitMix64 (Steele, Lea and Flood 2014): a small fixed-seed generator, so that the
+/// random choices of the starts are the same in every run and in the NumPy twin.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    /// An index below `m` (0 when `m` is 0).
+    fn below(&mut self, m: usize) -> usize {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) % m.max(1) as u64) as usize
+    }
+}
+
+/// A subsample of `m < n` of the `n` points, spread over the speed range and the same
+/// in every run: the points in order of speed cut into `m` runs of nearly equal length
+/// (`floor(j n/m)` up to `floor((j+1) n/m)`), one point drawn from each by a fixed-seed
+/// generator (not every k-th point, which a pattern in the data, such as a disturbance
+/// every tenth run, could alias). Returned in input order.
+pub(super) fn subsample(a: &[f64], m: usize) -> Vec<usize> {
+    let n = a.len();
+    if m >= n {
+        return (0..n).collect();
+    }
+    let by_speed = by_speed(a);
+    let mut rng = SplitMix64(0x5DEE_CE66_D1CE_5EED);
+    let cut = |j: usize| ((j as u128 * n as u128) / m as u128) as usize;
+    let mut out: Vec<usize> = (0..m)
+        .map(|j| {
+            let lo = cut(j);
+            by_speed[lo + rng.below(cut(j + 1) - lo)]
+        })
+        .collect();
+    out.sort_unstable();
     out
 }
 
@@ -366,7 +403,15 @@ pub(super) fn lts_scale(e: &[f64], h: usize) -> f64 {
     }
     // the fit had 4 parameters to bring the `h` residuals down
     let dof = (h as f64 - 4.0).max(1.0);
-    let mut s = (r2[..h].iter().sum::<f64>() / dof / truncated_variance(0.5 * (lo + hi))).sqrt();
+    let s = (r2[..h].iter().sum::<f64>() / dof / truncated_variance(0.5 * (lo + hi))).sqrt();
+    reweight_scale(&r2, s)
+}
+
+/// The reweighting of [`lts_scale`] from the scale `s`: twice, the points within
+/// [`LTS_REWEIGHT_CUT`] scales give the scale on `kept - 4` degrees of freedom,
+/// consistent for the truncation. `r2`: the squared residuals in increasing order.
+fn reweight_scale(r2: &[f64], s: f64) -> f64 {
+    let mut s = s;
     if s == 0.0 {
         return s;
     }
@@ -382,6 +427,16 @@ pub(super) fn lts_scale(e: &[f64], h: usize) -> f64 {
         .sqrt();
     }
     s
+}
+
+/// The scale of the residuals `e` of all points at a fit found on a subsample whose
+/// clean points had the scale `s`: [`lts_scale`]'s reweighting started from `s`
+/// rather than from the trimmed scale of a fixed share of the points (which, with
+/// about half the points gross errors, a share of all points no longer separates).
+pub(super) fn rescale(e: &[f64], s: f64) -> f64 {
+    let mut r2: Vec<f64> = e.iter().map(|x| x * x).filter(|x| !x.is_nan()).collect();
+    r2.sort_by(|a, b| a.total_cmp(b));
+    reweight_scale(&r2, s)
 }
 
 /// Keep start values inside the model's domain (all positive, `fs > fc`).
@@ -420,6 +475,40 @@ mod tests {
                 sd * 0.5 * (lo + hi)
             })
             .collect()
+    }
+
+    #[test]
+    fn subsample_is_spread_over_the_speeds_and_reproducible() {
+        // speeds in no particular order, two runs at each of 1500 speeds
+        let n = 3000;
+        let a: Vec<f64> = (0..n)
+            .map(|k| 1e-3 * (1 + (k * 7919) % 1500) as f64)
+            .collect();
+        let m = 400;
+        let sub = subsample(&a, m);
+        assert_eq!(sub, subsample(&a, m));
+        assert_eq!(sub.len(), m);
+        assert!(sub.windows(2).all(|w| w[0] < w[1]), "input order, distinct");
+        // one point from each run of the speed ranks
+        let order = by_speed(&a);
+        let mut rank = vec![0; n];
+        for (r, &i) in order.iter().enumerate() {
+            rank[i] = r;
+        }
+        let mut ranks: Vec<usize> = sub.iter().map(|&i| rank[i]).collect();
+        ranks.sort_unstable();
+        for (j, r) in ranks.iter().enumerate() {
+            assert!(j * n / m <= *r && *r < (j + 1) * n / m, "{j} {r}");
+        }
+        // a pattern every tenth point (in speed order, the order of a sweep) is not
+        // aliased: about a tenth of the subsample falls on it, as of the data
+        let sweep: Vec<f64> = (0..n).map(|k| 1e-4 * (k + 1) as f64).collect();
+        let on = subsample(&sweep, m)
+            .iter()
+            .filter(|&&i| i % 10 == 0)
+            .count();
+        assert!((20..=60).contains(&on), "{on} of {m}");
+        assert_eq!(subsample(&a[..50], 50), (0..50).collect::<Vec<_>>());
     }
 
     #[test]
