@@ -474,9 +474,13 @@ def test_friction_force_scale_shape_twins(data, dt, z0, exponent, use_scale):
     fa, za = lugre.friction_force(v, dt, m, z0=z0, return_z=True, scale=scale)
     fb, zb = ref.friction_force(v, dt, m, z0=z0, return_z=True, scale=scale)
     # same operations in the same order; a non-integer power may round its last bit
-    # differently in the two languages (seen: 1 ulp at exponent 1.0089)
-    np.testing.assert_allclose(fa, fb, rtol=1e-15, atol=0)
-    np.testing.assert_allclose(za, zb, rtol=1e-15, atol=1e-30)
+    # differently in the two languages (seen: 1 ulp at exponent 1.0089), and where the
+    # bristle and viscous forces nearly cancel that ulp of g is large against F (2.3e-15
+    # relative at exponent 0.908): a few ulps of the largest value, not of each
+    ulps = 0.0 if exponent is None else 4.0 * np.finfo(float).eps
+    np.testing.assert_allclose(fa, fb, rtol=1e-15, atol=ulps * float(np.max(np.abs(fa))))
+    np.testing.assert_allclose(za, zb, rtol=1e-15,
+                               atol=max(1e-30, ulps * float(np.max(np.abs(za)))))
 
 
 def test_friction_force_scale_is_g_multiplier():
