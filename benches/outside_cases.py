@@ -80,6 +80,8 @@ def plant(kind: str, xr: np.ndarray, size: float) -> tuple[np.ndarray, np.ndarra
         if kind == "force_ripple":
             force *= 1.0 + size * math.sin(2 * math.pi * x / 0.032 + 0.4)
         elif kind == "saturation":
+            if abs(force) > size:
+                integ -= e * dt  # anti-windup: the integrator holds while saturated
             force = max(-size, min(size, force))
         xs[k], cur[k] = x, i_cmd
         # friction on the body that carries it
