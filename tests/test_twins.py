@@ -42,8 +42,6 @@ def assert_same_result(a, b):
 #: Names of ``lugre`` that ``lugre.reference`` does not offer (yet), each with why. When
 #: a twin is added, its name leaves this list (the test below fails until it does).
 NOT_IN_REFERENCE = {
-    # computations still to be twinned
-    "steady_state_points": "plateau detection (src/estimate/plateaus.rs): not twinned yet",
     # pure Python on both sides already (no core to check): nothing to twin
     "design_static": "pure Python (lugre.design), over a StaticFit",
     "stribeck_determinacy": "pure Python (lugre.identify), counts samples of a record",
@@ -63,7 +61,8 @@ SHARED_FUNCTIONS = {"load_model", "save_model"}
 
 #: Facade functions that only forward to an implementation with the real signature.
 FORWARDED = {"fit_dynamic": ("lugre.identify", "fit_dynamic"),
-             "evaluate": ("lugre.diagnosis", "evaluate")}
+             "evaluate": ("lugre.diagnosis", "evaluate"),
+             "steady_state_points": ("lugre.identify", "steady_state_points")}
 
 #: Parameters of the facade that choose between the backends (the reference has one).
 BACKEND_CHOICE = {"backend"}
@@ -127,6 +126,8 @@ def test_reference_never_calls_the_core(monkeypatch):
         ref.fit_dynamic(rec, m, grid=False, max_iter=1)
     shared_case = shared_file("mismatch", "none")
     ref.evaluate(shared_case / "recording.csv", shared_case / "model.json")
+    pts = ref.steady_state_points(_plateau_table(), chunks=2)
+    assert pts.v.size == 4
     with pytest.raises(AssertionError, match="called lugre._core"):
         lugre.stribeck([0.1], m)
 
@@ -942,4 +943,276 @@ def test_evaluate_bad_input_same_errors():
         with pytest.raises(lugre.InputError) as e:
             backend.evaluate(42, m)
         msgs.append(str(e.value))
+    assert msgs[0] == msgs[1]
+
+
+# ---- steady_state_points: the plateau detection (src/estimate/plateaus.rs) -----------------
+
+
+def _plateau_table():
+    """Two plateaus (+0.1 and -0.1 m/s, 1 s each) made in NumPy alone, as a table."""
+    t = np.arange(2000) * 1e-3
+    vr = np.where(t < 1.0, 0.1, -0.1)
+    x = np.where(t < 1.0, 0.1 * t, 0.2 - 0.1 * t)
+    return {"t": t, "x": x, "F": 50.0 * np.sign(vr) + np.cos(t), "v_ref": vr}
+
+
+def assert_same_points(a, b):
+    """Two SteadyStatePoints are equal: points, plateaus, mask and notes."""
+    assert isinstance(b, type(a))
+    for k in ("v", "F", "F_std", "used"):
+        x, y = getattr(a, k), getattr(b, k)
+        assert x.dtype == y.dtype and x.shape == y.shape, k
+        np.testing.assert_array_equal(x, y, err_msg=k)
+    assert a.plateaus == b.plateaus
+    assert a.notes == b.notes
+
+
+def _passes_record(seed=0):
+    """Constant-speed passes of the paper's axis under its PID loop, both directions at
+    five speeds (0.001 m/s sticks and slips and never settles), with encoder and
+    current noise; the speed reference is recorded."""
+    m = lugre.Model.paper()
+    n1 = 800  # 0.8 s per pass
+    vr = np.concatenate([np.full(n1, d * s) for s in (0.001, 0.005, 0.02, 0.08, 0.2)
+                         for d in (1.0, -1.0)])
+    t = np.arange(vr.size) * 1e-3
+    xr = np.concatenate([[0.0], np.cumsum(vr[:-1] * 1e-3)])
+    s = lugre.simulate(m, t, xr)
+    rng = np.random.default_rng(seed)
+    return lugre.Recording(t=t, x=s.x + 1e-7 * rng.standard_normal(t.size),
+                           i=s.i + 0.01 * rng.standard_normal(t.size), v_ref=vr, x_ref=xr)
+
+
+@pytest.mark.parametrize("chunks", [1, 4])
+@pytest.mark.parametrize("with_v_ref", [True, False], ids=["v_ref", "from-x"])
+def test_steady_state_points_twins_simulated(with_v_ref, chunks):
+    """Plateaus found from ``v_ref``, or from the velocity differentiated from ``x``:
+    the same points, plateaus and notes, bit for bit."""
+    rec = _passes_record()
+    if not with_v_ref:
+        rec = lugre.Recording(t=rec.t, x=rec.x, i=rec.i)
+    a = lugre.steady_state_points(rec, 25.0, chunks=chunks)
+    b = ref.steady_state_points(rec, 25.0, chunks=chunks)
+    assert_same_points(a, b)
+    # both directions settle at the higher speeds, the slowest passes do not
+    assert np.sum(a.v > 0.01) >= 2 * chunks and np.sum(a.v < -0.01) >= 2 * chunks
+    assert any("did not settle" in n for n in a.notes)
+    assert not all(p["settled"] for p in a.plateaus)
+
+
+def test_steady_state_points_twins_table_input():
+    rec = _passes_record(seed=1)
+    table = {"t": rec.t, "x": rec.x, "i": rec.i, "v_ref": rec.v_ref}
+    a = lugre.steady_state_points(table, 25.0, settle_fraction=0.5, min_samples=50)
+    b = ref.steady_state_points(table, 25.0, settle_fraction=0.5, min_samples=50)
+    assert_same_points(a, b)
+    assert a.v.size >= 4
+
+
+@pytest.mark.parametrize("chunks", [1, 3])
+@pytest.mark.parametrize("with_v_ref", [True, False], ids=["v_ref", "from-x"])
+def test_steady_state_points_twins_on_shared_record(with_v_ref, chunks):
+    """The shared raw plateau record (t, x, i, v_ref at 1 kHz; K_F = 25 N/A), read from
+    its file by both, and without its v_ref column."""
+    path = shared_file("static", "paper_axis_plateaus.csv")
+    if with_v_ref:
+        rec = path
+    else:
+        full = lugre.read_recording(path)
+        rec = lugre.Recording(t=full.t, x=full.x, i=full.i)
+    a = lugre.steady_state_points(rec, 25.0, chunks=chunks)
+    b = ref.steady_state_points(rec, 25.0, chunks=chunks)
+    assert_same_points(a, b)
+    assert np.sum(a.v > 0) >= 4 and np.sum(a.v < 0) >= 4
+
+
+@st.composite
+def plateau_records(draw):
+    """A random raw plateau record: runs of constant nominal speed (some zero, some with
+    a drift through them), each approached by a first-order lag; a jittered time grid,
+    position and force noise; options of the detection."""
+    n_plat = draw(st.integers(1, 6))
+    plats = [(draw(st.sampled_from([0.0, 1.0, -1.0])) * 10.0 ** draw(st.floats(-3.0, -0.5)),
+              draw(st.integers(8, 500)),  # samples
+              draw(st.floats(0.5, 60.0)),  # lag time constant [samples]
+              draw(st.sampled_from([0.0, 0.0, 0.3])))  # relative drift over the run
+             for _ in range(n_plat)]
+    dt = draw(st.sampled_from([1e-4, 1e-3, 2e-3]))
+    jitter = draw(st.sampled_from([0.0, 0.2]))
+    x_noise = draw(st.sampled_from([0.0, 1e-8, 1e-6]))
+    f_noise = draw(st.sampled_from([0.0, 0.5]))
+    seed = draw(st.integers(0, 2**32 - 1))
+    rng = np.random.default_rng(seed)
+    nominal = np.concatenate([np.full(n, v) for v, n, _, _ in plats])
+    target = np.concatenate([v * (1.0 + d * np.arange(n) / n) for v, n, _, d in plats])
+    tau = np.concatenate([np.full(n, tc) for _, n, tc, _ in plats])
+    vel = np.empty(target.size)
+    v = 0.0
+    for k in range(target.size):
+        v += (target[k] - v) / tau[k]
+        vel[k] = v
+    steps = dt * (1.0 + jitter * rng.uniform(-1.0, 1.0, target.size))
+    t = np.cumsum(steps)
+    x = np.cumsum(vel * steps) + x_noise * rng.standard_normal(t.size)
+    F = 30.0 * np.sign(vel) + 300.0 * vel + f_noise * rng.standard_normal(t.size)
+    opts = {"settle_fraction": draw(st.sampled_from([0.0, 0.3, 0.7])),
+            "velocity_tolerance": draw(st.sampled_from([0.005, 0.02, 0.1])),
+            "chunks": draw(st.integers(1, 4)), "min_samples": draw(st.integers(0, 40))}
+    v_ref = nominal if draw(st.booleans()) else None
+    return t, x, F, v_ref, opts, draw(st.sampled_from([0, 1, 4, 11]))
+
+
+def _outcome(call):
+    """The result of ``call()``, or the class and message of what it raised."""
+    try:
+        return call(), None
+    except (lugre.LugreError, OverflowError) as e:
+        return None, (type(e), str(e))
+
+
+@settings(max_examples=80, deadline=None)
+@given(case=plateau_records())
+def test_steady_state_points_twins_generated(case):
+    """Random plateau records: the facades agree bit for bit, or refuse alike; so do the
+    kernels (the core's binding and its twin) with an explicit velocity window, which the
+    facade leaves automatic."""
+    from lugre import _core
+    from lugre._reference_plateaus import plateaus
+
+    t, x, F, v_ref, opts, window = case
+    rec = lugre.Recording(t=t, x=x, F=F, v_ref=v_ref)
+    a, ea = _outcome(lambda: lugre.steady_state_points(rec, **opts))
+    b, eb = _outcome(lambda: ref.steady_state_points(rec, **opts))
+    assert ea == eb
+    if ea is None:
+        assert_same_points(a, b)
+    else:
+        assert ea[0] is lugre.DataError
+    args = (t, x, F, v_ref, opts["settle_fraction"], opts["velocity_tolerance"], window,
+            opts["min_samples"], opts["chunks"])
+    ka, ea = _outcome(lambda: _core.plateaus(*args))
+    kb, eb = _outcome(lambda: plateaus(*args))
+    assert ea == eb
+    if ea is None:
+        assert set(ka) == set(kb)
+        for k in ka:
+            if k in ("v", "F", "F_std"):
+                np.testing.assert_array_equal(ka[k], kb[k], err_msg=k)
+            else:
+                assert ka[k] == kb[k], k
+
+
+def test_steady_state_points_twins_drifting_plateau():
+    """A plateau whose speed drifts through it (from 2 % under to 1.9 % over its
+    reference, so every window is within the 2 % tolerance once settled) is skipped with
+    the same note by both."""
+    n = 1500
+    ramp = 0.05 * (0.98 + 0.039 * np.arange(n) / n)
+    vel = np.concatenate([np.full(n, -0.05), ramp])
+    t = np.arange(2 * n) * 1e-3
+    x = np.concatenate([[0.0], np.cumsum(vel[:-1] * 1e-3)])
+    rec = lugre.Recording(t=t, x=x, F=40.0 * np.sign(vel), v_ref=np.sign(vel) * 0.05)
+    a = lugre.steady_state_points(rec)
+    b = ref.steady_state_points(rec)
+    assert_same_points(a, b)
+    assert [p["settled"] for p in a.plateaus] == [True, False]
+    assert "drifts through it" in a.notes[0]
+
+
+def _ramp_record():
+    t = np.arange(3000) * 1e-3
+    return lugre.Recording(t=t, x=0.05 * t * t, F=np.full(t.size, 40.0))
+
+
+def _still_record():
+    t = np.arange(500) * 1e-3
+    return lugre.Recording(t=t, x=np.zeros(t.size), F=np.ones(t.size),
+                           v_ref=np.zeros(t.size))
+
+
+def _current_record():
+    rec = lugre.Recording(**{k: v for k, v in _plateau_table().items() if k != "F"},
+                          i=np.full(2000, 2.0))
+    return rec
+
+
+BAD_PLATEAUS = [
+    # (description, record, keywords, exception class, message text)
+    ("settle_fraction 1", _plateau_table, {"settle_fraction": 1.0}, lugre.ParameterError,
+     "parameter settle_fraction = 1 is invalid: it must be in [0, 1)"),
+    ("settle_fraction negative", _plateau_table, {"settle_fraction": -0.1},
+     lugre.ParameterError, "parameter settle_fraction = -0.1 is invalid"),
+    ("settle_fraction nan", _plateau_table, {"settle_fraction": math.nan},
+     lugre.ParameterError, "parameter settle_fraction = NaN is invalid"),
+    ("velocity_tolerance 0", _plateau_table, {"velocity_tolerance": 0.0},
+     lugre.ParameterError,
+     "parameter velocity_tolerance = 0 is invalid: it must be a finite number greater"),
+    ("velocity_tolerance inf", _plateau_table, {"velocity_tolerance": math.inf},
+     lugre.ParameterError, "parameter velocity_tolerance = inf is invalid"),
+    ("velocity_tolerance nan", _plateau_table, {"velocity_tolerance": math.nan},
+     lugre.ParameterError, "parameter velocity_tolerance = NaN is invalid"),
+    ("chunks negative", _plateau_table, {"chunks": -1}, OverflowError,
+     "negative int to unsigned"),
+    ("min_samples negative", _plateau_table, {"min_samples": -5}, OverflowError,
+     "negative int to unsigned"),
+    ("min_samples too many", _plateau_table, {"min_samples": 10**6}, lugre.DataError,
+     "data: no settled constant-velocity plateau found (2 candidate segments)"),
+    ("no plateau in a ramp", _ramp_record, {}, lugre.DataError,
+     "no settled constant-velocity plateau found"),
+    ("standing still", _still_record, {}, lugre.DataError,
+     "plateau found (0 candidate segments)"),
+    ("no force constant", _current_record, {}, lugre.InputError,
+     "input force_constant: the recording holds the current i"),
+    ("force constant negative", _current_record, {"force_constant": -25.0},
+     lugre.InputError, "input force_constant: is -25.0"),
+]
+
+
+@pytest.mark.parametrize("desc,record,kw,cls,text", BAD_PLATEAUS,
+                         ids=[b[0] for b in BAD_PLATEAUS])
+def test_steady_state_points_bad_input_same_errors(desc, record, kw, cls, text):
+    msgs = []
+    for backend in BACKENDS:
+        with pytest.raises(cls) as e:
+            backend.steady_state_points(record(), **kw)
+        assert text in str(e.value), str(e.value)
+        msgs.append((type(e.value), str(e.value), getattr(e.value, "name", None),
+                     getattr(e.value, "value", None)))
+    assert msgs[0][:3] == msgs[1][:3]
+    a, b = msgs[0][3], msgs[1][3]
+    assert a == b or (math.isnan(a) and math.isnan(b))
+
+
+T5 = np.arange(5) * 1e-3
+X5 = 0.01 * T5
+BAD_PLATEAU_KERNEL = [
+    # the core's checks, which a Recording makes first on the facade's path
+    ("empty", (np.zeros(0), np.zeros(0), np.zeros(0)), "input t: is empty"),
+    ("t repeated", (np.r_[T5[:3], T5[2], T5[4]], X5, X5), "input t: time is not strictly"),
+    ("t nan", (np.r_[T5[:4], np.nan], X5, X5), "input t: element 4 is NaN"),
+    ("x length", (T5, X5[:4], X5), "input x: has 4 samples but t has 5"),
+    ("force length", (T5, X5, X5[:3]), "input force: has 3 samples but t has 5"),
+    ("x inf", (T5, np.r_[X5[:1], np.inf, X5[2:]], X5), "input x: element 1 is inf"),
+    ("force nan", (T5, X5, np.r_[X5[:4], np.nan]), "input force: element 4 is NaN"),
+    ("v_ref length", (T5, X5, X5, X5[:2]), "input v_ref: has 2 samples but t has 5"),
+    ("v_ref nan", (T5, X5, X5, np.r_[np.nan, X5[1:]]), "input v_ref: element 0 is NaN"),
+    ("x before settle_fraction", (T5, X5[:2], X5, None, 2.0), "input x: has 2 samples"),
+]
+
+
+@pytest.mark.parametrize("desc,args,text", BAD_PLATEAU_KERNEL,
+                         ids=[b[0] for b in BAD_PLATEAU_KERNEL])
+def test_plateau_kernel_bad_input_same_errors(desc, args, text):
+    """The kernels check their arrays themselves, in the same order, with the same
+    words, whatever the facade let through."""
+    from lugre import _core
+    from lugre._reference_plateaus import plateaus
+
+    msgs = []
+    for kernel in (_core.plateaus, plateaus):
+        with pytest.raises(lugre.InputError) as e:
+            kernel(*args)
+        assert text in str(e.value), str(e.value)
+        msgs.append((str(e.value), e.value.name))
     assert msgs[0] == msgs[1]

@@ -244,11 +244,26 @@ def steady_state_points(recording: Recording | str, force_constant: float | None
     settle_fraction, velocity_tolerance, chunks, min_samples
         See above; ``chunks > 1`` cuts each settled plateau into replicate points.
     """
+    return _steady_state_points(_core.plateaus, recording, force_constant, columns=columns,
+                                settle_fraction=settle_fraction,
+                                velocity_tolerance=velocity_tolerance, chunks=chunks,
+                                min_samples=min_samples)
+
+
+def _steady_state_points(plateaus: Callable[..., dict[str, Any]],
+                         recording: Recording | str, force_constant: float | None, *,
+                         columns: dict[str, str] | None, settle_fraction: float,
+                         velocity_tolerance: float, chunks: int,
+                         min_samples: int) -> SteadyStatePoints:
+    """:func:`steady_state_points` around ``plateaus(t, x, force, v_ref, settle_fraction,
+    velocity_tolerance, window, min_samples, chunks)``, the plateau detection (the core's
+    binding, or the NumPy twin's in ``lugre.reference``): the recording and its force,
+    the result and its notes."""
     rec = recording if isinstance(recording, Recording) else read_recording(recording, columns)
     F = rec.force(force_constant)
-    r = _core.plateaus(rec.t, rec.x, np.ascontiguousarray(F, dtype=float),
-                       None if rec.v_ref is None else rec.v_ref, float(settle_fraction),
-                       float(velocity_tolerance), 0, int(min_samples), int(chunks))
+    r = plateaus(rec.t, rec.x, np.ascontiguousarray(F, dtype=float),
+                 None if rec.v_ref is None else rec.v_ref, float(settle_fraction),
+                 float(velocity_tolerance), 0, int(min_samples), int(chunks))
     plateaus = [
         {"start": s, "end": e, "velocity": v, "first_used": f, "settled": ok}
         for s, e, v, f, ok in zip(r["segment_start"], r["segment_end"], r["segment_velocity"],

@@ -12,7 +12,8 @@ step) and meant for checking the core and for reading. Never calls :mod:`lugre._
   (``_reference_static``), :func:`fit_dynamic` (``_reference_dynamic``), built on
   Nelder-Mead as the core runs it (``_reference_nm``) and the robust weights
   (``_reference_robust``); their results are the facade's :class:`StaticFit` and
-  :class:`DynamicFit`;
+  :class:`DynamicFit`; :func:`steady_state_points` (``_reference_plateaus``), the
+  plateau detection, returns the facade's :class:`~lugre.identify.SteadyStatePoints`;
 - :func:`evaluate` runs the diagnosis's preparation of the record (SciPy filters) with
   the residual from :class:`InverseRecord`, the NumPy twin of the inverse-dynamics
   kernel (``_reference_inverse``); :func:`diagnose` and :func:`fit_inverse_dynamics`
@@ -59,6 +60,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from ._reference_diagnose import diagnose, fit_inverse_dynamics
     from ._reference_dynamic import DynamicFit, fit_dynamic
     from ._reference_evaluate import evaluate
+    from ._reference_plateaus import steady_state_points
     from ._reference_static import StaticFit, fit_static
 
 __all__ = [
@@ -78,6 +80,7 @@ __all__ = [
     "save_model",
     "simulate",
     "simulate_batch",
+    "steady_state_points",
     "stribeck",
 ]
 
@@ -92,6 +95,7 @@ _LAZY = {
     "evaluate": "._reference_evaluate",
     "diagnose": "._reference_diagnose",
     "fit_inverse_dynamics": "._reference_diagnose",
+    "steady_state_points": "._reference_plateaus",
 }
 
 
