@@ -78,3 +78,14 @@ def test_a_real_delay_is_still_named(plant):
     dg = diagnose(rec, model, closed_loop=False)
     lag = [f for f in dg.findings if f.effect in ("delay", "current_lag")]
     assert lag, dg.summary()
+
+
+def test_force_dependent_friction_is_no_payload(plant):
+    """Friction growing 5 % with the force the drive transmits reads as a heavier axis
+    while the drive speeds it up, and a lighter one while it brakes: a payload is the
+    same mass both ways, so no mass is named and the rest is described."""
+    rec, model = _case(plant, "load_friction", 0.05, 960, "p2p")
+    dg = diagnose(rec, model, closed_loop=False)
+    assert "mass" not in [f.effect for f in dg.findings]
+    u = dg.unexplained
+    assert u is not None and any("not a payload" in s for s in u["shape"])

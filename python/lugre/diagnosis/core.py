@@ -247,6 +247,25 @@ def diagnose(
                 scorer, ctx, [c for c in cands if c.effect != "delay"], alpha=alpha,
                 min_gain=min_gain, noise_rms=noise["rms"], min_force=min_force)
             log += log2
+    # a mass term that differs speeding up and braking is no payload
+    mass_ways = None
+    mass_k = next((k for k, t in enumerate(terms) if t.effect == "mass" and not t.minor),
+                  None)
+    if mass_k is not None:
+        chk = V.mass_both_ways(scorer, terms, mass_k, ev, ctx)
+        if chk is not None and chk["not_payload"]:
+            mass_ways = chk
+            for g in log:
+                if g["accepted"] and g["effect"] == "mass":
+                    g["accepted"] = False
+                    g["why"] += (f"; not named: {chk['speeding_up']:+.2g} kg speeding up, "
+                                 f"{chk['braking']:+.2g} kg braking (no payload)")
+            terms, ev, log2 = forward_select(
+                scorer, ctx, [c for c in cands if c.effect not in ("mass", "delay")
+                              or (c.effect == "delay" and lag_rev is None)],
+                alpha=alpha, min_gain=min_gain, noise_rms=noise["rms"],
+                min_force=min_force)
+            log += log2
     # the presliding test again, with the terms in: a mismatch the vocabulary explains
     # (a Stribeck shape at low speed, a small mass error) no longer passes for presliding,
     # and presliding hidden behind one can show once it is explained
@@ -406,7 +425,7 @@ def diagnose(
 
     located = {"before": locate(r0, sig, noise["rms"]), "after": locate(r1, sig, noise["rms"])}
     unexplained = V.unexplained(r1, sig, noise["rms"], located["after"], fit["after"],
-                                lag_rev)
+                                lag_rev, mass_ways)
     if unexplained is not None and resembles:
         unexplained["resembles"] = resembles
         unexplained["message"] = unexplained["message"].replace(

@@ -290,15 +290,57 @@ def lag_at_reversals(scorer: Scorer, terms: list[Term], k: int, ev: Any,
                                    and tau - tau_away > 4.0 * se)}
 
 
+def mass_both_ways(scorer: Scorer, terms: list[Term], k: int, ev: Any,
+                   ctx: Any) -> dict[str, Any] | None:
+    """Is the mass term ``terms[k]`` a payload, the same mass speeding up and braking?
+
+    A payload adds ``delta*a`` whichever way the force points. A friction that grows
+    with the force the drive transmits (a preloaded nut, a guide loaded by the drive)
+    adds ``mu*|F|`` against the motion: like a heavier axis while the axis speeds up,
+    like a lighter one while the drive brakes it. The term is refitted, jointly with the
+    base and the other terms, on the samples where the drive speeds the axis up
+    (``F*v > 0`` and ``a*v > 0``) and on those where it brakes (``F*v < 0``); when both
+    determine it (standard errors under a quarter of the full fit's) and they differ by
+    more than four combined standard errors and by more than half the full fit, the
+    term is no payload. Returns the figures, or None when the record cannot tell.
+    """
+    sig = ctx.sig
+    m = scorer.mask
+    fv = sig.fm_f * sig.vf
+    up = m & (fv > 0) & (sig.a * sig.vf > 0)
+    brake = m & (fv < 0)
+    if up.sum() < 0.05 * m.sum() or brake.sum() < 0.05 * m.sum():
+        return None
+    q = scorer.J.shape[1]
+    start = q + sum(t.X.shape[1] for t in terms[:k])
+    full = float(ev.beta[start])
+    x = terms[k].X[:, 0]
+    out: dict[str, Any] = {"delta_kg": full}
+    for name, sel in (("speeding_up", up), ("braking", brake)):
+        sxx = float(np.sum(x[sel] ** 2))
+        if not sxx > 0:
+            return None
+        ev2 = Scorer(scorer.r, scorer.J, scorer.tol, sel, scorer.s2, scorer.K).evaluate(terms)
+        out[name] = float(ev2.beta[start])
+        out[name + "_se"] = float(np.sqrt(scorer.s2 / sxx))
+    a, b = out["speeding_up"], out["braking"]
+    se = float(np.hypot(out["speeding_up_se"], out["braking_se"]))
+    out["not_payload"] = bool(max(out["speeding_up_se"], out["braking_se"]) < 0.25 * abs(full)
+                              and abs(a - b) > 4.0 * se and abs(a - b) > 0.5 * abs(full))
+    return out
+
+
 def unexplained(r: np.ndarray, sig: R.Signals, floor: float, where: dict[str, Any],
-                after: dict[str, float], lag_rev: dict[str, Any] | None = None
-                ) -> dict[str, Any] | None:
+                after: dict[str, float], lag_rev: dict[str, Any] | None = None,
+                mass_ways: dict[str, Any] | None = None) -> dict[str, Any] | None:
     """The rest above twice the noise floor: where it lives and what shape it has
-    (``lag_rev``: a lag that fitted the reversals only, :func:`lag_at_reversals`)."""
+    (``lag_rev``: a lag that fitted the reversals only, :func:`lag_at_reversals`;
+    ``mass_ways``: a mass term that differs speeding up and braking,
+    :func:`mass_both_ways`)."""
     from .locate import short_ranges
 
     rms1 = after["rms_force"]
-    if rms1 <= 2.0 * floor and lag_rev is None:
+    if rms1 <= 2.0 * floor and lag_rev is None and mass_ways is None:
         return None
     m = sig.mask
     rr = r[m]
@@ -314,6 +356,15 @@ def unexplained(r: np.ndarray, sig: R.Signals, floor: float, where: dict[str, An
             "the force everywhere, but lost motion at each change of direction, e.g. "
             "backlash between motor and load or a presliding stage the model does not "
             "hold")
+    if mass_ways is not None:
+        shape.append(
+            f"the acceleration force reads as {mass_ways['speeding_up']:+.2g} kg while the "
+            f"drive speeds the axis up and {mass_ways['braking']:+.2g} kg while it brakes "
+            "(+- "
+            f"{2 * max(mass_ways['speeding_up_se'], mass_ways['braking_se']):.2g}): not a "
+            "payload, which is the same mass both ways, but a force that grows with the "
+            "force the drive transmits, e.g. friction of a preloaded nut or of a guide "
+            "loaded by the drive")
     if lag_rev is None and rev.any() and share_rev > 2.0 * rev.mean() and share_rev > 0.3:
         shape.append(
             f"{100 * share_rev:.0f} % of the rest lies within 50 ms of the {nrev} "
