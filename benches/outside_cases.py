@@ -19,6 +19,8 @@ does not read as a mismatch. Kinds:
 - ``viscous_warmup``: the viscous coefficient falls as the lubricant warms (the
   Coulomb level stays).
 - ``saturation``: the drive limits its force; the logged current is the command.
+- ``encoder``: a periodic error of the position reading (4 mm period), the motion itself
+  unaffected: an apparent force growing with the square of the speed.
 """
 
 from __future__ import annotations
@@ -121,6 +123,8 @@ def record(kind: str, size: float, seed: int, duration: float, traj: str):
     tf = np.arange(int(duration * RATE)) / RATE
     xr = reference(traj, tf, seed)
     x, i = plant(kind, xr, size)
+    if kind == "encoder":  # a periodic error of the scale: the motion is right, its reading not
+        x = x + size * np.sin(2 * np.pi * x / 0.004 + 0.3)
     over = 10
     t = tf[::over]
     i = i[::over] + 0.01 * rng.standard_normal(t.size)
@@ -163,7 +167,8 @@ CASES = [("clean_sines", "clean", 0.0, "sines"), ("clean_p2p", "clean", 0.0, "p2
          ("load_friction", "load_friction", 0.05, "sines"),
          ("load_friction_p2p", "load_friction", 0.05, "p2p"),
          ("viscous_warmup", "viscous_warmup", 0.3, "sines"),
-         ("saturation_p2p", "saturation", 90.0, "p2p")]
+         ("saturation_p2p", "saturation", 90.0, "p2p"),
+         ("encoder", "encoder", 2e-6, "sines")]
 
 
 def main() -> None:

@@ -21,12 +21,17 @@ from .refit import refine, split
 from .report import Diagnosis, Finding
 from .search import Scorer, accept, compare, forward_select
 
-__all__ = ["MIN_SHARE", "PARTIAL_REST", "as_recording", "diagnose", "evaluate"]
+__all__ = ["EXCESS_FLOOR", "MIN_SHARE", "PARTIAL_REST", "as_recording", "diagnose", "evaluate"]
 
 #: Least rms force of a finding, as a share of the rms motor force: effects below it are
 #: statistically visible on clean records (a 0.1 % mass error, the half period of a
 #: 10 kHz controller's hold) but change nothing a user would act on.
 MIN_SHARE = 0.003
+
+#: A noise floor (after the findings) above this many times what the recorded current's
+#: noise and the encoder's resolution explain holds mismatch spread over the band (clean
+#: records: 0.9-1.1 times; backlash impacts 4-5 times).
+EXCESS_FLOOR = 3.0
 
 #: A rest above this many noise floors, with under 90 % of the mismatch explained,
 #: makes the accepted terms look-alikes of something outside the vocabulary.
@@ -424,8 +429,14 @@ def diagnose(
             fit["closed_loop"] = cl
 
     located = {"before": locate(r0, sig, noise["rms"]), "after": locate(r1, sig, noise["rms"])}
+    # a floor far above what the current's noise and the encoder explain holds
+    # mismatch spread over the band: "nothing found" would hide it
+    expected = R.expected_floor(sig, aug)
+    excess = None
+    if noise_after["rms"] > EXCESS_FLOOR * expected["rms"] > 0:
+        excess = {"floor": noise_after["rms"], "expected": expected["rms"]}
     unexplained = V.unexplained(r1, sig, noise["rms"], located["after"], fit["after"],
-                                lag_rev, mass_ways)
+                                lag_rev, mass_ways, excess)
     if unexplained is not None and resembles:
         unexplained["resembles"] = resembles
         unexplained["message"] = unexplained["message"].replace(
@@ -446,7 +457,10 @@ def diagnose(
             "effects": data_effects}
     dg = Diagnosis(findings=findings, fit=fit, model=model, augmented=aug, base=base_rep,
                    noise={**noise, "rms_before_refit": R.noise_floor(r0, sig)["rms"],
-                          "rms_after": noise_after["rms"]},
+                          "rms_after": noise_after["rms"],
+                          "expected_rms": expected["rms"],
+                          "expected_current": expected["current"],
+                          "expected_encoder": expected["encoder"]},
                    located=located, unexplained=unexplained, notes=notes, trials=log,
                    data=data)
     dg.could_not_reveal = hidden

@@ -332,15 +332,17 @@ def mass_both_ways(scorer: Scorer, terms: list[Term], k: int, ev: Any,
 
 def unexplained(r: np.ndarray, sig: R.Signals, floor: float, where: dict[str, Any],
                 after: dict[str, float], lag_rev: dict[str, Any] | None = None,
-                mass_ways: dict[str, Any] | None = None) -> dict[str, Any] | None:
+                mass_ways: dict[str, Any] | None = None,
+                excess: dict[str, float] | None = None) -> dict[str, Any] | None:
     """The rest above twice the noise floor: where it lives and what shape it has
     (``lag_rev``: a lag that fitted the reversals only, :func:`lag_at_reversals`;
     ``mass_ways``: a mass term that differs speeding up and braking,
-    :func:`mass_both_ways`)."""
+    :func:`mass_both_ways`; ``excess``: a noise floor far above what the measurements
+    explain, ``floor`` and ``expected`` [N])."""
     from .locate import short_ranges
 
     rms1 = after["rms_force"]
-    if rms1 <= 2.0 * floor and lag_rev is None and mass_ways is None:
+    if rms1 <= 2.0 * floor and lag_rev is None and mass_ways is None and excess is None:
         return None
     m = sig.mask
     rr = r[m]
@@ -356,6 +358,15 @@ def unexplained(r: np.ndarray, sig: R.Signals, floor: float, where: dict[str, An
             "the force everywhere, but lost motion at each change of direction, e.g. "
             "backlash between motor and load or a presliding stage the model does not "
             "hold")
+    if excess is not None:
+        shape.append(
+            f"the residual's noise floor, {excess['floor']:.2g} N, is "
+            f"{excess['floor'] / excess['expected']:.0f} times what the recorded current's "
+            f"noise and the encoder's resolution explain ({excess['expected']:.2g} N): "
+            "mismatch spread over the whole band is counted as noise (impacts, e.g. at "
+            "the reversals; an error of the position reading periodic in position, "
+            "crossed at changing speeds; a ripple of the drive), and effects under that "
+            "floor stay hidden")
     if mass_ways is not None:
         shape.append(
             f"the acceleration force reads as {mass_ways['speeding_up']:+.2g} kg while the "

@@ -435,6 +435,44 @@ def noise_floor(r: np.ndarray, sig: Signals) -> dict[str, float]:
     return {"rms": math.sqrt(max(var, 1e-30)), "n_eff": n_eff, "bandwidth_hz": b_eq}
 
 
+def expected_floor(sig: Signals, model: Model) -> dict[str, float]:
+    """The noise floor the measurements alone would give: the recorded current's noise
+    and the encoder's resolution, through the residual's filter.
+
+    The current's noise is taken white at the level of the motor force's spectrum
+    between 0.5 and 0.9 of the Nyquist frequency (median over the band, corrected for
+    the chi-square spread of the Welch estimate); the position's quantisation ``q``
+    white with variance ``q^2/12``, twice differentiated and times the mass. On clean
+    records this matches :func:`noise_floor` to 10 %; a floor several times larger
+    holds mismatch spread over the band.
+
+    Returns
+    -------
+    dict
+        ``rms`` [N], and its parts ``current`` and ``encoder`` [N].
+    """
+    from scipy import stats
+
+    y = sig.fm[sig.mask]
+    ff = np.linspace(0.0, 0.5 * sig.fs, 4001)
+    _, h = signal.sosfreqz(_butter(4, sig.cutoff_hz / (0.5 * sig.fs)), worN=ff, fs=sig.fs)
+    f2 = np.abs(h) ** 4
+    df = ff[1] - ff[0]
+    vi = 0.0
+    if y.size >= 256:
+        nper = int(min(1024, y.size))
+        f, p = signal.welch(y - np.mean(y), fs=sig.fs, nperseg=nper)
+        band = (f > 0.25 * sig.fs) & (f < 0.45 * sig.fs)
+        if np.sum(band) >= 3:
+            dof = 2.0 * max(1, 2 * y.size // nper - 1) * 0.9
+            level = float(np.median(p[band]) / (stats.chi2.ppf(0.5, dof) / dof))
+            vi = level * float(np.sum(f2)) * df
+    q = float(sig.info.get("quantum", 0.0))
+    pa = (2.0 * np.pi * ff) ** 4 * q * q / 12.0 / (0.5 * sig.fs)
+    va = float(model.mass) ** 2 * float(np.sum(pa * f2)) * df
+    return {"rms": math.sqrt(vi + va), "current": math.sqrt(vi), "encoder": math.sqrt(va)}
+
+
 def check_units(sig: Signals, model: Model) -> None:
     """Warn when the motion and the model's mass and friction disagree by ~1000x.
 
