@@ -362,12 +362,11 @@ def unexplained(r: np.ndarray, sig: R.Signals, floor: float, where: dict[str, An
         shape.append(
             f"the residual's noise floor, {excess['floor']:.2g} N, is "
             f"{excess['floor'] / excess['expected']:.0f} times what the recorded current's "
-            f"noise and the encoder's resolution explain ({excess['expected']:.2g} N): "
-            "either the position reading is noisier than its resolution, or mismatch "
-            "spread over the whole band is counted as noise (impacts, e.g. at the "
-            "reversals; an error of the position reading periodic in position, crossed "
-            "at changing speeds; a ripple of the drive); effects under that floor stay "
-            "hidden")
+            f"noise and the position reading's noise explain ({excess['expected']:.2g} "
+            "N, both measured above the motion's band): mismatch spread over the whole "
+            "band is counted as noise (impacts, e.g. at the reversals; an error of the "
+            "position reading periodic in position, crossed at changing speeds; a ripple "
+            "of the drive); effects under that floor stay hidden")
     if mass_ways is not None:
         shape.append(
             f"the acceleration force reads as {mass_ways['speeding_up']:+.2g} kg while the "

@@ -441,10 +441,13 @@ def expected_floor(sig: Signals, model: Model) -> dict[str, float]:
 
     The current's noise is taken white at the level of the motor force's spectrum
     between 0.5 and 0.9 of the Nyquist frequency (median over the band, corrected for
-    the chi-square spread of the Welch estimate); the position's quantisation ``q``
-    white with variance ``q^2/12``, twice differentiated and times the mass. On clean
-    records this matches :func:`noise_floor` to 10 %; a floor several times larger
-    holds mismatch spread over the band.
+    the chi-square spread of the Welch estimate); the position reading's noise white at
+    the larger of its quantisation (``q^2/12``) and the level of its second difference's
+    spectrum in the same band (a reading noisier than its resolution), twice
+    differentiated and times the mass. On clean records this matches
+    :func:`noise_floor` to 10 %; a floor several times larger holds mismatch spread
+    over the band (EMPS: the reading's noise is 1.16 times its quantisation, the floor
+    26 times the expected).
 
     Returns
     -------
@@ -468,7 +471,18 @@ def expected_floor(sig: Signals, model: Model) -> dict[str, float]:
             level = float(np.median(p[band]) / (stats.chi2.ppf(0.5, dof) / dof))
             vi = level * float(np.sum(f2)) * df
     q = float(sig.info.get("quantum", 0.0))
-    pa = (2.0 * np.pi * ff) ** 4 * q * q / 12.0 / (0.5 * sig.fs)
+    sx = q * q / 12.0 / (0.5 * sig.fs)  # one-sided density of the reading's noise
+    xr = np.asarray(sig.x_raw, float)[sig.mask]
+    if xr.size >= 258:
+        a2 = np.diff(xr, 2)
+        nper = int(min(1024, a2.size))
+        f, p = signal.welch(a2 - np.mean(a2), fs=sig.fs, nperseg=nper)
+        band = (f > 0.25 * sig.fs) & (f < 0.45 * sig.fs)
+        if np.sum(band) >= 3:
+            dof = 2.0 * max(1, 2 * a2.size // nper - 1) * 0.9
+            g = (2.0 - 2.0 * np.cos(2.0 * np.pi * f[band] / sig.fs)) ** 2
+            sx = max(sx, float(np.median(p[band] / g) / (stats.chi2.ppf(0.5, dof) / dof)))
+    pa = (2.0 * np.pi * ff) ** 4 * sx
     va = float(model.mass) ** 2 * float(np.sum(pa * f2)) * df
     return {"rms": math.sqrt(vi + va), "current": math.sqrt(vi), "encoder": math.sqrt(va)}
 
