@@ -233,44 +233,32 @@ def diagnose(
     min_force = MIN_SHARE * _rms(sig.fm_f, sig.mask)
     terms, ev, log = forward_select(scorer, ctx, cands, alpha=alpha, min_gain=min_gain,
                                     noise_rms=noise["rms"], min_force=min_force)
-    # a lag that fits the reversals but not the motion between them is lost motion,
-    # not timing: it is not named, and the rest is described instead
-    lag_rev = None
-    lag_k = next((k for k, t in enumerate(terms) if t.effect == "delay" and not t.minor),
-                 None)
-    if lag_k is not None:
-        chk = V.lag_at_reversals(scorer, terms, lag_k, ev, ctx)
-        if chk is not None and chk["reversals_only"]:
-            lag_rev = chk
-            for g in log:
-                if g["accepted"] and g["effect"] == "delay":
-                    g["accepted"] = False
-                    g["why"] += (f"; not named: between the reversals the lag is "
-                                 f"{chk['lag_away_s'] * 1e3:.2g} ms, not "
-                                 f"{chk['lag_s'] * 1e3:.2g} ms (lost motion, not timing)")
-            terms, ev, log2 = forward_select(
-                scorer, ctx, [c for c in cands if c.effect != "delay"], alpha=alpha,
-                min_gain=min_gain, noise_rms=noise["rms"], min_force=min_force)
-            log += log2
-    # a mass term that differs speeding up and braking is no payload
-    mass_ways = None
-    mass_k = next((k for k, t in enumerate(terms) if t.effect == "mass" and not t.minor),
-                  None)
-    if mass_k is not None:
-        chk = V.mass_both_ways(scorer, terms, mass_k, ev, ctx)
-        if chk is not None and chk["not_payload"]:
-            mass_ways = chk
-            for g in log:
-                if g["accepted"] and g["effect"] == "mass":
-                    g["accepted"] = False
-                    g["why"] += (f"; not named: {chk['speeding_up']:+.2g} kg speeding up, "
-                                 f"{chk['braking']:+.2g} kg braking (no payload)")
-            terms, ev, log2 = forward_select(
-                scorer, ctx, [c for c in cands if c.effect not in ("mass", "delay")
-                              or (c.effect == "delay" and lag_rev is None)],
-                alpha=alpha, min_gain=min_gain, noise_rms=noise["rms"],
-                min_force=min_force)
-            log += log2
+    # a named term whose physics fails its own check is refused, and the search runs
+    # again without it: a lag that fits the reversals but not the motion between them
+    # is lost motion, not timing; a mass that differs speeding up and braking is no
+    # payload. The rest is described instead.
+    refused: dict[str, dict[str, Any]] = {}
+    for effect, check, key, why in (
+            ("delay", V.lag_at_reversals, "reversals_only",
+             lambda c: (f"between the reversals the lag is {c['lag_away_s'] * 1e3:.2g} ms, "
+                        f"not {c['lag_s'] * 1e3:.2g} ms (lost motion, not timing)")),
+            ("mass", V.mass_both_ways, "not_payload",
+             lambda c: (f"{c['speeding_up']:+.2g} kg speeding up, {c['braking']:+.2g} kg "
+                        "braking (no payload)"))):
+        k = next((k for k, t in enumerate(terms) if t.effect == effect and not t.minor), None)
+        chk = None if k is None else check(scorer, terms, k, ev, ctx)
+        if chk is None or not chk[key]:
+            continue
+        refused[effect] = chk
+        for g in log:
+            if g["accepted"] and g["effect"] == effect:
+                g["accepted"] = False
+                g["why"] += "; not named: " + why(chk)
+        terms, ev, log2 = forward_select(
+            scorer, ctx, [c for c in cands if c.effect not in refused], alpha=alpha,
+            min_gain=min_gain, noise_rms=noise["rms"], min_force=min_force)
+        log += log2
+    lag_rev, mass_ways = refused.get("delay"), refused.get("mass")
     # the presliding test again, with the terms in: a mismatch the vocabulary explains
     # (a Stribeck shape at low speed, a small mass error) no longer passes for presliding,
     # and presliding hidden behind one can show once it is explained

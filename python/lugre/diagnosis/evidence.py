@@ -256,6 +256,24 @@ def reversals(sig: R.Signals, window: float = 0.05) -> tuple[np.ndarray, int]:
     return rev & sig.mask, int(flips.size)
 
 
+def _start(scorer: Scorer, terms: list[Term], k: int) -> int:
+    """Index of the first coefficient of ``terms[k]`` in a fit's ``beta``."""
+    return scorer.J.shape[1] + sum(t.X.shape[1] for t in terms[:k])
+
+
+def _refit_on(scorer: Scorer, terms: list[Term], k: int, sel: np.ndarray
+              ) -> tuple[float, float] | None:
+    """The first coefficient of ``terms[k]`` refitted, jointly with the base and the
+    other terms, on the samples ``sel`` alone, and its standard error; None when those
+    samples hold nothing of its column."""
+    x = terms[k].X[:, 0]
+    sxx = float(np.sum(x[sel] ** 2))
+    if not sxx > 0:
+        return None
+    ev = Scorer(scorer.r, scorer.J, scorer.tol, sel, scorer.s2, scorer.K).evaluate(terms)
+    return float(ev.beta[_start(scorer, terms, k)]), float(np.sqrt(scorer.s2 / sxx))
+
+
 def lag_at_reversals(scorer: Scorer, terms: list[Term], k: int, ev: Any,
                      ctx: Any) -> dict[str, Any] | None:
     """Is the lag term ``terms[k]`` a time shift of the whole force, or a mismatch at
@@ -275,16 +293,11 @@ def lag_at_reversals(scorer: Scorer, terms: list[Term], k: int, ev: Any,
     away = scorer.mask & ~rev
     if nrev == 0 or away.sum() < 0.2 * scorer.mask.sum():
         return None
-    q = scorer.J.shape[1]
-    start = q + sum(t.X.shape[1] for t in terms[:k])
-    tau = float(ev.beta[start])
-    x = terms[k].X[:, 0]
-    sxx = float(np.sum(x[away] ** 2))
-    if not (tau > 0 and sxx > 0):
+    tau = float(ev.beta[_start(scorer, terms, k)])
+    fit = _refit_on(scorer, terms, k, away) if tau > 0 else None
+    if fit is None:
         return None
-    se = float(np.sqrt(scorer.s2 / sxx))
-    ev2 = Scorer(scorer.r, scorer.J, scorer.tol, away, scorer.s2, scorer.K).evaluate(terms)
-    tau_away = float(ev2.beta[start])
+    tau_away, se = fit
     return {"lag_s": tau, "lag_away_s": tau_away, "se_s": se, "reversals": nrev,
             "reversals_only": bool(se < 0.25 * tau and tau_away < 0.5 * tau
                                    and tau - tau_away > 4.0 * se)}
@@ -311,18 +324,13 @@ def mass_both_ways(scorer: Scorer, terms: list[Term], k: int, ev: Any,
     brake = m & (fv < 0)
     if up.sum() < 0.05 * m.sum() or brake.sum() < 0.05 * m.sum():
         return None
-    q = scorer.J.shape[1]
-    start = q + sum(t.X.shape[1] for t in terms[:k])
-    full = float(ev.beta[start])
-    x = terms[k].X[:, 0]
+    full = float(ev.beta[_start(scorer, terms, k)])
     out: dict[str, Any] = {"delta_kg": full}
     for name, sel in (("speeding_up", up), ("braking", brake)):
-        sxx = float(np.sum(x[sel] ** 2))
-        if not sxx > 0:
+        fit = _refit_on(scorer, terms, k, sel)
+        if fit is None:
             return None
-        ev2 = Scorer(scorer.r, scorer.J, scorer.tol, sel, scorer.s2, scorer.K).evaluate(terms)
-        out[name] = float(ev2.beta[start])
-        out[name + "_se"] = float(np.sqrt(scorer.s2 / sxx))
+        out[name], out[name + "_se"] = fit
     a, b = out["speeding_up"], out["braking"]
     se = float(np.hypot(out["speeding_up_se"], out["braking_se"]))
     out["not_payload"] = bool(max(out["speeding_up_se"], out["braking_se"]) < 0.25 * abs(full)

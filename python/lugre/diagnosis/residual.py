@@ -435,6 +435,33 @@ def noise_floor(r: np.ndarray, sig: Signals) -> dict[str, float]:
     return {"rms": math.sqrt(max(var, 1e-30)), "n_eff": n_eff, "bandwidth_hz": b_eq}
 
 
+def hf_level(y: np.ndarray, fs: float, gain: Any = None) -> float | None:
+    """One-sided density of the white noise in ``y`` (divided by ``gain(f)``, the power
+    gain it went through, when given), from the median of its Welch spectrum between
+    0.5 and 0.9 of the Nyquist frequency, above the motion's band, corrected for the
+    chi-square spread of the estimate; None for under 256 samples or too few bins."""
+    from scipy import stats
+
+    if y.size < 256:
+        return None
+    nper = int(min(1024, y.size))
+    f, p = signal.welch(y - np.mean(y), fs=fs, nperseg=nper)
+    band = (f > 0.25 * fs) & (f < 0.45 * fs)
+    if np.sum(band) < 3:
+        return None
+    dof = 2.0 * max(1, 2 * y.size // nper - 1) * 0.9
+    pb = p[band] if gain is None else p[band] / gain(f[band])
+    return float(np.median(pb) / (stats.chi2.ppf(0.5, dof) / dof))
+
+
+def filter_power(sig: Signals) -> tuple[np.ndarray, np.ndarray]:
+    """Frequencies 0 to Nyquist (4001 points) and the power gain of the residual's
+    zero-phase low-pass there (``|H|^4``: squared magnitude, applied twice)."""
+    ff = np.linspace(0.0, 0.5 * sig.fs, 4001)
+    _, h = signal.sosfreqz(_butter(4, sig.cutoff_hz / (0.5 * sig.fs)), worN=ff, fs=sig.fs)
+    return ff, np.abs(h) ** 4
+
+
 def expected_floor(sig: Signals, model: Model) -> dict[str, float]:
     """The noise floor the measurements alone would give: the recorded current's noise
     and the encoder's resolution, through the residual's filter.
@@ -454,34 +481,18 @@ def expected_floor(sig: Signals, model: Model) -> dict[str, float]:
     dict
         ``rms`` [N], and its parts ``current`` and ``encoder`` [N].
     """
-    from scipy import stats
-
-    y = sig.fm[sig.mask]
-    ff = np.linspace(0.0, 0.5 * sig.fs, 4001)
-    _, h = signal.sosfreqz(_butter(4, sig.cutoff_hz / (0.5 * sig.fs)), worN=ff, fs=sig.fs)
-    f2 = np.abs(h) ** 4
+    ff, f2 = filter_power(sig)
     df = ff[1] - ff[0]
-    vi = 0.0
-    if y.size >= 256:
-        nper = int(min(1024, y.size))
-        f, p = signal.welch(y - np.mean(y), fs=sig.fs, nperseg=nper)
-        band = (f > 0.25 * sig.fs) & (f < 0.45 * sig.fs)
-        if np.sum(band) >= 3:
-            dof = 2.0 * max(1, 2 * y.size // nper - 1) * 0.9
-            level = float(np.median(p[band]) / (stats.chi2.ppf(0.5, dof) / dof))
-            vi = level * float(np.sum(f2)) * df
+    level = hf_level(sig.fm[sig.mask], sig.fs)
+    vi = 0.0 if level is None else level * float(np.sum(f2)) * df
     q = float(sig.info.get("quantum", 0.0))
     sx = q * q / 12.0 / (0.5 * sig.fs)  # one-sided density of the reading's noise
     xr = np.asarray(sig.x_raw, float)[sig.mask]
     if xr.size >= 258:
-        a2 = np.diff(xr, 2)
-        nper = int(min(1024, a2.size))
-        f, p = signal.welch(a2 - np.mean(a2), fs=sig.fs, nperseg=nper)
-        band = (f > 0.25 * sig.fs) & (f < 0.45 * sig.fs)
-        if np.sum(band) >= 3:
-            dof = 2.0 * max(1, 2 * a2.size // nper - 1) * 0.9
-            g = (2.0 - 2.0 * np.cos(2.0 * np.pi * f[band] / sig.fs)) ** 2
-            sx = max(sx, float(np.median(p[band] / g) / (stats.chi2.ppf(0.5, dof) / dof)))
+        # the second difference of white noise of density sx: (2 - 2 cos w)^2 * sx
+        read = hf_level(np.diff(xr, 2), sig.fs,
+                        lambda f: (2.0 - 2.0 * np.cos(2.0 * np.pi * f / sig.fs)) ** 2)
+        sx = sx if read is None else max(sx, read)
     pa = (2.0 * np.pi * ff) ** 4 * sx
     va = float(model.mass) ** 2 * float(np.sum(pa * f2)) * df
     return {"rms": math.sqrt(vi + va), "current": math.sqrt(vi), "encoder": math.sqrt(va)}

@@ -47,21 +47,11 @@ def smoothing_gain(sig: R.Signals, bandwidth: float, n: int, s2: float) -> float
     time: 19 units of 15 measured; a 90 Hz lag on the generator: 46 of 41): the
     forms are told apart by what remains.
     """
-    from scipy import signal, stats
-
-    y = sig.fm[sig.mask]
-    if y.size < 256 or not bandwidth > 0:
+    level = R.hf_level(sig.fm[sig.mask], sig.fs) if bandwidth > 0 else None
+    if level is None:
         return 0.0
-    nper = int(min(1024, y.size))
-    f, p = signal.welch(y - np.mean(y), fs=sig.fs, nperseg=nper)
-    band = (f > 0.25 * sig.fs) & (f < 0.45 * sig.fs)
-    if np.sum(band) < 3:
-        return 0.0
-    dof = 2.0 * max(1, 2 * y.size // nper - 1) * 0.9
-    level = float(np.median(p[band]) / (stats.chi2.ppf(0.5, dof) / dof))
-    ff = np.linspace(0.0, 0.5 * sig.fs, 4001)
-    _, h = signal.sosfreqz(R._butter(4, sig.cutoff_hz / (0.5 * sig.fs)), worN=ff, fs=sig.fs)
-    w = np.abs(h) ** 4 * (ff / bandwidth) ** 2 / (1.0 + (ff / bandwidth) ** 2)
+    ff, f2 = R.filter_power(sig)
+    w = f2 * (ff / bandwidth) ** 2 / (1.0 + (ff / bandwidth) ** 2)
     integral = float(np.sum(0.5 * (w[1:] + w[:-1])) * (ff[1] - ff[0]))
     return n * level * integral / s2
 
