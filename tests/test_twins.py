@@ -1216,3 +1216,19 @@ def test_plateau_kernel_bad_input_same_errors(desc, args, text):
         assert text in str(e.value), str(e.value)
         msgs.append((str(e.value), e.value.name))
     assert msgs[0] == msgs[1]
+
+
+@pytest.mark.parametrize("call", [
+    lambda b: b.stribeck(0.1, paper()),
+    lambda b: b.friction_force(0.1, 1e-3, paper()),
+    lambda b: b.simulate(paper(), [0.0, 1e-3, 2e-3], current=1.0),
+], ids=["stribeck", "friction_force", "simulate"])
+def test_scalar_for_an_array_same_error(call):
+    """A scalar where an array is due: both backends refuse it with the same message
+    (the core's facade once took it as a one-element array)."""
+    msgs = []
+    for backend in BACKENDS:
+        with pytest.raises(lugre.InputError) as e:
+            call(backend)
+        msgs.append(str(e.value))
+    assert msgs[0] == msgs[1] and "1-D" in msgs[0], msgs

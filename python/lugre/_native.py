@@ -16,20 +16,16 @@ from . import _core
 from ._result import CouplingResult, SimResult
 from .exceptions import InputError
 from .model import ModelLike, _as_model
+from .reference import _array as _ref_array
 from .reference import _check_substeps_type, _select_drive
 
 __all__ = ["friction_force", "load_coupling", "simulate", "simulate_batch", "stribeck"]
 
 
 def _array(name: str, a: Any) -> np.ndarray:
-    """A contiguous 1-D float64 array, or :class:`InputError` naming the argument."""
-    try:
-        arr = np.ascontiguousarray(a, dtype=np.float64)
-    except (TypeError, ValueError) as e:
-        raise InputError.at(name, f"must be an array of numbers ({e})") from None
-    if arr.ndim != 1:
-        raise InputError.at(name, f"must be a 1-D array, got shape {arr.shape}")
-    return arr
+    """The reference's 1-D float64 array (same checks, same messages: a scalar is
+    refused by both), made contiguous for the core."""
+    return np.ascontiguousarray(_ref_array(name, a))
 
 
 def _core_model(model: ModelLike) -> Any:

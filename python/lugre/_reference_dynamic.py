@@ -24,7 +24,7 @@ import numpy as np
 
 from ._reference_nm import NmOptions, minimize
 from ._reference_robust import Weighting, robust_scale
-from ._reference_static import _as_points, _check_finite, _div, _usize
+from ._reference_static import _div, _usize
 from .exceptions import (
     DataError,
     InputError,
@@ -35,7 +35,7 @@ from .exceptions import (
 from .identify import DynamicFit, StaticFit, _dynamic_fit
 from .io import Recording
 from .model import Model, ModelLike, _Parsed
-from .reference import _check_time, _parsed, _simulate
+from .reference import _array, _check_finite, _check_time, _parsed, _simulate
 
 __all__ = ["DynamicFit", "fit_dynamic"]
 
@@ -455,9 +455,9 @@ def _record_call(mm: Model, rec: Recording, weighting: str, c1: float, c2: float
     if args[9] not in ("exact", "rk4"):
         raise InputError.at("integrator",
                             f'unknown integrator "{args[9]}": use "exact" or "rk4"')
-    t = _as_points("t", rec.t).tolist()
-    xr = _as_points("x_ref", rec.x_ref).tolist()
-    xm = _as_points("x", rec.x).tolist()
+    t = _array("t", rec.t).tolist()
+    xr = _array("x_ref", rec.x_ref).tolist()
+    xm = _array("x", rec.x).tolist()
     return _fit_record(m, t, xr, xm, wt, args[1], args[2],
                        None if s0 is None else float(s0), None if s1 is None else float(s1),
                        args[5], args[6], args[7], args[8], args[9])

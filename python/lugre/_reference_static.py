@@ -31,8 +31,9 @@ import numpy as np
 
 from ._reference_nm import NmOptions, minimize
 from ._reference_robust import Weighting, median, robust_scale, t_quantile_975
-from .exceptions import ConvergenceWarning, DataError, InputError, ParameterError, _fmt_f64
+from .exceptions import ConvergenceWarning, DataError, InputError, ParameterError
 from .identify import DirectionFit, StaticFit
+from .reference import _array, _check_finite
 
 __all__ = ["DirectionFit", "StaticFit", "fit_static"]
 
@@ -907,24 +908,6 @@ def _fit_direction(a: list[float], y: list[float], sign: float, indices: list[in
     }
 
 
-def _as_points(name: str, a: Any) -> np.ndarray:
-    """The facade's conversion (``_native._array``), written out here."""
-    try:
-        arr = np.ascontiguousarray(a, dtype=np.float64)
-    except (TypeError, ValueError) as e:
-        raise InputError.at(name, f"must be an array of numbers ({e})") from None
-    if arr.ndim != 1:
-        raise InputError.at(name, f"must be a 1-D array, got shape {arr.shape}")
-    return arr
-
-
-def _check_finite(name: str, a: list[float]) -> None:
-    for k, x in enumerate(a):
-        if not math.isfinite(x):
-            raise InputError.at(
-                name, f"element {k} is {_fmt_f64(x)} : remove or interpolate non-finite samples")
-
-
 def _usize(value: Any) -> int:
     """``int(value)`` as the binding takes a ``usize`` (negative: OverflowError)."""
     n = int(value)
@@ -967,8 +950,8 @@ def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
     ParameterError
         ``scale_floor`` negative or not finite, ``max_start_points`` below 5.
     """
-    va = _as_points("v", v).tolist()
-    fa = _as_points("F", F).tolist()
+    va = _array("v", v).tolist()
+    fa = _array("F", F).tolist()
     wname = str(weighting)
     iters = _usize(max_iter)
     start_points = _usize(max_start_points)
