@@ -516,6 +516,9 @@ class Model:
             )
         self._data = _plain(data)
         self._parsed = _parse(self._data)
+        self._warn_passivity()
+
+    def _warn_passivity(self) -> None:
         fr = self._parsed.friction
         for d in ("positive", "negative"):
             bound = getattr(fr, d).passivity_bound()
@@ -526,7 +529,7 @@ class Model:
                     "map is not passive (Barabanov & Ortega 2000); lower sigma1 or "
                     "check sigma2, fc and fs",
                     PassivityWarning,
-                    stacklevel=2,
+                    stacklevel=3,
                 )
 
     # ---- construction ---------------------------------------------------------------
@@ -793,13 +796,27 @@ class Model:
         -------
         Model
         """
-        d = self.to_dict()
+        # the untouched sections are shared, not copied: a model never changes its
+        # document in place (every accessor hands out copies)
+        d = dict(self._data)
         for k, val in sections.items():
+            if not isinstance(k, str):  # pragma: no cover - keywords are strings
+                raise ModelError.at("(model)", f"key {k!r} is not a string")
             if val is None:
                 d.pop(k, None)
             else:
-                d[k] = val
-        return Model(d)
+                d[k] = _plain(val, k)
+        return Model._checked(d)
+
+    @classmethod
+    def _checked(cls, plain: dict[str, Any]) -> Model:
+        """A model of a JSON-ready document (validated, not copied again)."""
+        m = cls.__new__(cls)
+        m._core = None
+        m._data = plain
+        m._parsed = _parse(plain)
+        m._warn_passivity()
+        return m
 
 
 ModelLike = Union[Model, Mapping[str, Any], str, "os.PathLike[str]"]
