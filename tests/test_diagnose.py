@@ -236,3 +236,29 @@ def test_physics_outside_the_vocabulary_is_unexplained():
     assert u is not None and u["where"]["position"]
     assert [r["effect"] for r in u["resembles"]] == ["position_friction"]
     assert dg.verdict.startswith("Unexplained")
+
+
+@pytest.mark.parametrize("effect", ["none", "cogging"])
+def test_fast_sampling_keeps_the_band_the_position_reading_allows(effect):
+    # at 10 kHz the usual fs/25 band (400 Hz) would carry about a hundred times the
+    # acceleration noise of the 1 µm encoder (twice differentiated, times the mass);
+    # a compliant load smooths the acceleration and "explained" it: a resonance named
+    # on a clean record. The band now ends where the reading's noise would dominate.
+    from lugre.diagnosis import residual as R
+
+    rec, believed, _ = concealed(None if effect == "none" else effect, duration=4.0,
+                                 rate_hz=10000.0)
+    sig = R.prepare(rec, believed)
+    assert 40.0 < sig.cutoff_hz < 100.0
+    assert sig.info["reading_band_hz"] == pytest.approx(sig.cutoff_hz)
+    # at 1 kHz the same axis keeps fs/25
+    rec1, believed1, _ = concealed(None, duration=4.0)
+    assert R.prepare(rec1, believed1).cutoff_hz == pytest.approx(40.0)
+    dg = diagnose(rec, believed, closed_loop=False)
+    assert [f.effect for f in dg.findings] == ([] if effect == "none" else ["cogging"])
+    if effect == "none":
+        assert dg.unexplained is None
+    # the noise floor follows the reading's f^4 noise: it matches what the measurements
+    # alone give (a flat floor read 0.04 N where they give 0.056 N)
+    noise = dg.noise
+    assert 0.85 < noise["rms"] / noise["expected_rms"] < 1.3

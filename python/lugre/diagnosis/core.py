@@ -197,11 +197,15 @@ def diagnose(
     held = [k for k, n in enumerate(names) if n not in B.PRESLIDING]
     noise = R.noise_floor(r0, sig)
     s2 = noise["rms"] ** 2 * n_used / noise["n_eff"]
-    ev_held = Scorer(r0, J[:, held], tol[held], sig.mask, s2, blocks).evaluate([])
+    # the held-out scores read every step-th sample (all they score is band-limited);
+    # short records keep at least 200 per block
+    step = max(1, min(sig.rows_step, n_used // (200 * int(blocks))))
+    ctx.extra["rows_step"] = step
+    ev_held = Scorer(r0, J[:, held], tol[held], sig.mask, s2, blocks, step=step).evaluate([])
     noise = R.noise_floor(ev_held.resid, sig)  # floor of the base-refit residual
     s2 = noise["rms"] ** 2 * n_used / noise["n_eff"]
-    sc_held = Scorer(r0, J[:, held], tol[held], sig.mask, s2, blocks)
-    sc_free = Scorer(r0, J, tol, sig.mask, s2, blocks)
+    sc_held = Scorer(r0, J[:, held], tol[held], sig.mask, s2, blocks, step=step)
+    sc_free = Scorer(r0, J, tol, sig.mask, s2, blocks, step=step)
     ev_held = sc_held.evaluate([])
     J_all, names_all, tol_all = J, names, tol
 
@@ -283,7 +287,7 @@ def diagnose(
         from .timing import choose_timing
 
         aug, base, betas, ctx, terms, alt = choose_timing(
-            model, sig, terms, lag_k, base0, betas, s2, names, scorer.blocks, min_gain,
+            model, sig, terms, lag_k, base0, betas, s2, names, scorer.used_blocks, min_gain,
             tolerance)
         if alt is not None:
             alternatives[lag_k] = [alt]
@@ -403,8 +407,9 @@ def diagnose(
                            "after": _metrics(r1, sig.fm_f, sig.mask),
                            "holdout_before": {}, "holdout_after": {}}
     if holdout is not None:
-        hb = evaluate(holdout, model, cutoff_hz=cutoff_hz, backend=backend)
-        ha = evaluate(holdout, aug, cutoff_hz=cutoff_hz, backend=backend)
+        # the same band as the diagnosis, so that the two records are compared alike
+        hb = evaluate(holdout, model, cutoff_hz=sig.cutoff_hz, backend=backend)
+        ha = evaluate(holdout, aug, cutoff_hz=sig.cutoff_hz, backend=backend)
         fit["holdout_before"] = {k: hb[k] for k in ("rms_force", "nrmse_force")}
         fit["holdout_after"] = {k: ha[k] for k in ("rms_force", "nrmse_force")}
     fit["held_out_blocks"] = {

@@ -57,8 +57,7 @@ def offset_alternative(scorer: Scorer, terms: list[Term], ev: Any, names: list[s
     rest = [t for t in terms if t.effect != "offset"]
     # the alternative at its best: Coulomb/static levels free (flat prior)
     free_tol = np.array([t * (1e3 if n in _OFFSET_LEVELS else 1.0) for n, t in zip(names, tol)])
-    alt = Scorer(scorer.r, scorer.J, free_tol, scorer.mask, scorer.s2, scorer.K,
-                 center=scorer.center).evaluate(rest)
+    alt = scorer.like(tol=free_tol).evaluate(rest)
     q = len(names)
     m_off = _moves(ev.beta[:q], names, tol)
     m_alt = _moves(alt.beta[:q], names, tol)
@@ -270,7 +269,7 @@ def _refit_on(scorer: Scorer, terms: list[Term], k: int, sel: np.ndarray
     sxx = float(np.sum(x[sel] ** 2))
     if not sxx > 0:
         return None
-    ev = Scorer(scorer.r, scorer.J, scorer.tol, sel, scorer.s2, scorer.K).evaluate(terms)
+    ev = scorer.like(mask=sel, center=None).evaluate(terms)
     return float(ev.beta[_start(scorer, terms, k)]), float(np.sqrt(scorer.s2 / sxx))
 
 
@@ -522,7 +521,9 @@ def _nonlinear_hidden(c: Any, ctx: Any, size: Any) -> dict[str, Any] | None:
             return _hide(c.effect, float("inf"), "Hz", "a resonance",
                          experiment="the filter band is too narrow; record faster")
         fs = sorted({h[0] for h in g})
-        hidden = [f for f in fs if size(c.columns((f, 0.05, 0.5), ctx)[:, 0]) > 1.0]
+        pts = [(f, 0.05, 0.5) for f in fs]
+        cols = c.columns_many(pts, ctx) or [c.columns(h, ctx) for h in pts]  # (in parallel)
+        hidden = [f for f, X in zip(fs, cols) if size(X[:, 0]) > 1.0]
         if not hidden:
             return None
         return _hide(c.effect, 0.5, "load fraction",

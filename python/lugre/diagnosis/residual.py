@@ -183,6 +183,18 @@ class Signals:
     kernel: Any = None
     backend: Any = None
 
+    @property
+    def rows_step(self) -> int:
+        """Every how many samples the held-out scores read the filtered signals.
+
+        Everything they score is low-passed at ``cutoff_hz``, so a product of two
+        columns has no content above ``2*cutoff_hz``; read at ``fs/step >= 5*cutoff_hz``,
+        the sums of products over every ``step``-th sample are ``1/step`` of the full
+        sums to well under a part in a thousand (what the filter passes at 2.5 times its
+        cut-off), at a ``step``-th of the work and memory.
+        """
+        return max(1, int(self.fs / (5.0 * self.cutoff_hz)))
+
     def filt(self, y: np.ndarray) -> np.ndarray:
         """Apply the parallel low-pass to a signal or to the columns of a matrix."""
         y = np.asarray(y, dtype=float)
@@ -279,7 +291,9 @@ def prepare(
     model : Model
         Supplies ``K_F`` when the recording holds the current.
     cutoff_hz : float, optional
-        Parallel low-pass cut-off; default ``fs/25`` (40 Hz at 1 kHz).
+        Parallel low-pass cut-off; default ``fs/25`` (40 Hz at 1 kHz), lowered to
+        where the position reading's noise would dominate (:func:`reading_band`; not
+        under 10 Hz).
     drive_cutoff_hz : float, optional
         Low-pass of the velocity that drives the bristles; default ``fs/6``.
     t0 : float, optional
@@ -294,10 +308,14 @@ def prepare(
     n = len(rec)
     dt = rec.dt
     fs = 1.0 / dt
-    fc = float(cutoff_hz) if cutoff_hz is not None else fs / 25.0
     fd = float(drive_cutoff_hz) if drive_cutoff_hz is not None else fs / 6.0
     force_raw = rec.force(model)
     fm, spikes = hampel(force_raw)
+    limit = reading_band(rec.x, fm, fs, float(model.mass))
+    if cutoff_hz is not None:
+        fc = float(cutoff_hz)
+    else:
+        fc = fs / 25.0 if limit is None else min(fs / 25.0, max(limit, 10.0))
     x = lowpass(rec.x, fc, fs)
     vf = np.gradient(x, dt)
     a = np.gradient(vf, dt)
@@ -337,7 +355,8 @@ def prepare(
                    fm_f=fm_f, dfm=dfm, spikes=spikes, mask=mask, x_raw=rec.x.copy(),
                    force_raw=force_raw, recording=rec,
                    info={"drive_cutoff_hz": fd, "quantum": q, "edge": edge, "x_drive": xd,
-                         "filter": (sos, padlen)},
+                         "filter": (sos, padlen), "reading_band_hz": limit,
+                         "cutoff_default": cutoff_hz is None},
                    kernel=kernel, backend=mod)
 
 
@@ -423,16 +442,69 @@ def noise_floor(r: np.ndarray, sig: Signals) -> dict[str, float]:
     band = (f >= 0.25 * fc) & (f <= 0.9 * fc)
     if np.sum(band) < 4:  # pragma: no cover - tiny records
         band = f > 0
+    # the noise's shape: the force reading's white noise plus the position reading's,
+    # twice differentiated (density growing as f^4), equal at f_eq
+    f_eq = _equal_noise_hz(sig.info.get("reading_band_hz"))
+    shape = np.ones_like(f) if f_eq is None else 1.0 + (f / f_eq) ** 4
+    g = h2 * shape
     segs = max(1, 2 * n // nper - 1)  # Hann, half overlap
     dof = 2.0 * segs * 0.9
     q = 0.3
-    level = float(np.quantile(p[band] / np.maximum(h2[band], 1e-12), q)
+    level = float(np.quantile(p[band] / np.maximum(g[band], 1e-12), q)
                   / (stats.chi2.ppf(q, dof) / dof))
     df = f[1] - f[0]
     b_eq = float(np.sum(h2) * df)  # one-sided equivalent noise bandwidth [Hz]
-    var = level * b_eq
+    var = level * float(np.sum(g) * df)
+    if f_eq is not None:  # a coloured noise has fewer independent samples: the band
+        # (sum g)^2/sum g^2, relative to the same for the filter alone
+        b_eq *= (float(np.sum(g)) ** 2 / float(np.sum(g * g))) / (
+            float(np.sum(h2)) ** 2 / float(np.sum(h2 * h2)))
     n_eff = max(min(n * 2.0 * b_eq / sig.fs, float(n)), 10.0)
     return {"rms": math.sqrt(max(var, 1e-30)), "n_eff": n_eff, "bandwidth_hz": b_eq}
+
+
+#: The position reading's noise, twice differentiated and times the mass, may reach
+#: this multiple of the force reading's noise within the residual's band.
+READING_NOISE_RATIO = 2.0
+
+
+def reading_band(x: np.ndarray, fm: np.ndarray, fs: float, mass: float) -> float | None:
+    """Highest cut-off [Hz] at which the position reading still does not dominate the
+    residual's noise, or None when the record does not tell.
+
+    The inverse dynamics takes the acceleration from the position twice differentiated:
+    a reading noise of density ``sx`` (quantisation ``q^2/12`` or more, see
+    :func:`expected_floor`) gives a force noise of density ``m^2 (2 pi f)^4 sx``, whose
+    power up to ``fc`` grows as ``fc^5`` while the force reading's white noise (density
+    ``sf``) grows as ``fc``. They are equal at ``fc = (5 sf/(m^2 sx))^(1/4)/(2 pi)``;
+    the band ends where the first is :data:`READING_NOISE_RATIO` times the second. This
+    does not depend on the sample rate: at 1 kHz the usual ``fs/25`` is within it; at
+    10 kHz ``fs/25`` (400 Hz) would put a hundred times the acceleration noise into the
+    residual, which any term that smooths the acceleration (a compliant load) then
+    "explains".
+    """
+    x = np.asarray(x, float)
+    fm = np.asarray(fm, float)
+    if x.size < 258:
+        return None
+    level = hf_level(fm, fs)
+    steps = np.abs(np.diff(x))
+    q = float(np.min(steps[steps > 0])) if np.any(steps > 0) else 0.0
+    sx = q * q / 12.0 / (0.5 * fs)
+    read = hf_level(np.diff(x, 2), fs, lambda f: (2.0 - 2.0 * np.cos(2.0 * np.pi * f / fs)) ** 2)
+    sx = max(sx, read or 0.0)
+    if level is None or not level > 0 or not sx > 0 or not mass > 0:
+        return None
+    ratio2 = READING_NOISE_RATIO ** 2
+    return float((5.0 * ratio2 * level / (mass * mass * sx)) ** 0.25 / (2.0 * np.pi))
+
+
+def _equal_noise_hz(band_hz: float | None) -> float | None:
+    """Frequency where the reading's differentiated noise density equals the force
+    reading's (from :func:`reading_band`'s cut-off)."""
+    if band_hz is None:
+        return None
+    return band_hz / (5.0 * READING_NOISE_RATIO ** 2) ** 0.25
 
 
 def hf_level(y: np.ndarray, fs: float, gain: Any = None) -> float | None:

@@ -89,6 +89,16 @@ class Evaluation:
         return self.r - self.fitted
 
 
+def rows_count(n: int, step: int) -> int:
+    """Rows ``0, step, 2*step, ...`` of ``n`` samples."""
+    return -(-n // step)
+
+
+def rows_of(X: np.ndarray, step: int) -> np.ndarray:
+    """Every ``step``-th row of ``X`` as its own array (the full one can be freed)."""
+    return X if step <= 1 else np.ascontiguousarray(X[::step])
+
+
 class Scorer:
     """Held-out scoring of joint fits (base Jacobian plus effect columns).
 
@@ -108,26 +118,37 @@ class Scorer:
         Number of contiguous held-out blocks.
     center : numpy.ndarray, optional
         Prior mean of the base changes (default 0: the model as given).
+    step : int, default 1
+        Read every ``step``-th sample only (:attr:`Signals.rows_step
+        <lugre.diagnosis.residual.Signals.rows_step>`); sums count for every sample.
     """
 
     def __init__(self, r: np.ndarray, J: np.ndarray, tol: np.ndarray, mask: np.ndarray,
-                 sigma_eff2: float, blocks: int = 10, center: np.ndarray | None = None
-                 ) -> None:
+                 sigma_eff2: float, blocks: int = 10, center: np.ndarray | None = None,
+                 step: int = 1) -> None:
         self.r = r
         self.J = J
         self.tol = tol
         self.mask = mask
         self.s2 = float(sigma_eff2)
         self.K = int(blocks)
-        idx = np.flatnonzero(mask)
+        self.step = int(step)
+        self.n = int(mask.size)
+        # the samples read: every step-th of the record (a fixed grid, so that columns
+        # kept at those rows only serve every scorer) among those used
+        keep = mask.copy()
+        if self.step > 1:
+            keep[np.arange(self.n) % self.step != 0] = False
+        idx = np.flatnonzero(keep)
         nb = idx.size // self.K  # equal blocks (the last few samples are left out)
         idx = idx[:nb * self.K]
         self.idx = idx
         self._nb = nb
-        # the used samples as one slice when they are contiguous (the usual mask: the
-        # filter's edges left out): blocks of a column are then views, not copies
-        self._span = (slice(int(idx[0]), int(idx[-1]) + 1)
-                      if idx.size and idx[-1] - idx[0] == idx.size - 1 else None)
+        # the samples read as one strided slice when they are evenly spaced (the usual
+        # mask: the filter's edges left out): blocks of a column are then views
+        self._span = None
+        if idx.size and np.all(np.diff(idx) == self.step):
+            self._span = slice(int(idx[0]), int(idx[-1]) + 1, self.step)
         self._products: dict[int, tuple[Any, tuple[np.ndarray, ...]]] = {}
         self._cross: dict[tuple[int, int], tuple[Any, Any, np.ndarray]] = {}
         edges = np.arange(self.K + 1) * nb
@@ -135,18 +156,44 @@ class Scorer:
         self.center = np.zeros(J.shape[1]) if center is None else np.asarray(center, float)
         # per-block products of the base columns and the residual, once: an evaluation
         # adds only its own columns' products (the search runs hundreds of them)
-        self._Jm = self._stack(J[idx])
-        self._rm = self._stack(r[idx][:, None])
+        self._Jm = self._blocks_of(J)
+        self._rm = self._blocks_of(r[:, None])
         self._GJJ = self._gram(self._Jm, self._Jm)
         self._hJ = self._gram(self._Jm, self._rm)[:, :, 0]
         self._rr = self._gram(self._rm, self._rm)[:, 0, 0]
+
+    @property
+    def used_blocks(self) -> list[slice]:
+        """The held-out blocks as slices of the used samples (``r[mask]``), every
+        sample of each stretch, not only those read."""
+        used = np.flatnonzero(self.mask)
+        starts = [int(np.searchsorted(used, self.idx[b.start])) for b in self.blocks]
+        end = int(np.searchsorted(used, self.idx[-1] + self.step)) if self.idx.size else 0
+        return [slice(a, b) for a, b in zip(starts, starts[1:] + [end])]
+
+    def like(self, **changes: Any) -> Scorer:
+        """A scorer of the same residual, base and rows with some arguments changed
+        (``J``, ``tol``, ``mask``, ``blocks``, ``center``)."""
+        kw: dict[str, Any] = {"r": self.r, "J": self.J, "tol": self.tol, "mask": self.mask,
+                              "sigma_eff2": self.s2, "blocks": self.K, "center": self.center,
+                              "step": self.step}
+        kw.update(changes)
+        return Scorer(**kw)
 
     def _stack(self, a: np.ndarray) -> np.ndarray:
         """``(n, c)`` samples as ``(K, n/K, c)`` blocks."""
         return a.reshape(self.K, self._nb, a.shape[1])
 
     def _blocks_of(self, X: np.ndarray) -> np.ndarray:
-        """The used samples of the columns ``X`` as ``(K, n/K, p)`` blocks."""
+        """The samples read of the columns ``X`` as ``(K, n/K, p)`` blocks.
+
+        ``X`` holds every sample of the record, or (with ``step > 1``) only every
+        ``step``-th, as :func:`rows_of` keeps them.
+        """
+        if self.step > 1 and X.shape[0] == rows_count(self.n, self.step):
+            return self._stack(X[self.idx // self.step])
+        if X.shape[0] != self.n:
+            raise ValueError(f"columns of {X.shape[0]} rows for a record of {self.n}")
         if self._span is not None:
             return self._stack(np.ascontiguousarray(X[self._span]))
         return self._stack(X[self.idx])
@@ -173,10 +220,10 @@ class Scorer:
         self._cross[key] = (weakref.ref(X1), weakref.ref(X2), g)
         return g
 
-    @staticmethod
-    def _gram(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """Per-block ``a.T @ b``."""
-        return np.matmul(a.transpose(0, 2, 1), b)
+    def _gram(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Per-block ``a.T @ b``, in units of every sample (times ``step``)."""
+        g = np.matmul(a.transpose(0, 2, 1), b)
+        return g * self.step if self.step > 1 else g
 
     def evaluate(self, terms: list[Term]) -> Evaluation:
         """Fit base plus ``terms`` on all blocks and on each leave-one-block-out set.
@@ -220,7 +267,7 @@ class Scorer:
             o += pi
         rr_b = self._rr
         diag = np.einsum("kii->i", G_b)
-        sc = np.sqrt(diag / self.idx.size)
+        sc = np.sqrt(diag / (self.idx.size * self.step))
         sc[sc == 0] = 1.0
         G_b = G_b / np.outer(sc, sc)
         h_b = h_b / sc
@@ -239,43 +286,52 @@ class Scorer:
         A = np.diag(lam + eps)
 
         def solve(Gm: np.ndarray, hm: np.ndarray) -> np.ndarray:
+            """``(Gm + A) b = hm + lam*cen``; ``Gm`` one matrix or a stack of them."""
             try:
-                return np.linalg.solve(Gm + A, hm + lam * cen)
+                return np.linalg.solve(Gm + A, (hm + lam * cen)[..., None])[..., 0]
             except np.linalg.LinAlgError:
+                if Gm.ndim == 3:  # one singular block fit: each alone, by least squares
+                    return np.array([solve(g, v) for g, v in zip(Gm, hm)])
                 return np.linalg.lstsq(Gm + A, hm + lam * cen, rcond=None)[0]
 
         b = solve(G, h)
         sse = float(rr - 2 * b @ h + b @ G @ b)
         prior = float(np.sum(prec * (b - cen) ** 2))
-        sse_b = np.empty(self.K)
-        jack = np.empty((self.K, b.size))
-        for k in range(self.K):
-            bk = solve(G - G_b[k], h - h_b[k])
-            sse_b[k] = rr_b[k] - 2 * bk @ h_b[k] + bk @ G_b[k] @ bk
-            jack[k] = bk / sc
+        # the K leave-one-block-out fits as one stacked solve
+        bk = solve(G[None] - G_b, h[None] - h_b)
+        sse_b = (rr_b - 2 * np.einsum("ki,ki->k", bk, h_b)
+                 + np.einsum("ki,ki->k", np.matmul(G_b, bk[:, :, None])[:, :, 0], bk))
+        jack = bk / sc
         beta = b / sc
         score = float(sse_b.sum() / self.s2 + prior)
         return Evaluation(score=score, sse_b=sse_b, prior=prior, beta=beta, sse=sse,
                           splits=self.blocks, jack=jack, r=self.r, J=self.J, X=Xs)
 
 
-def make_term(c: Candidate, h: Any, ctx: Context) -> Term:
+def make_term(c: Candidate, h: Any, ctx: Context, *, rows: bool = False) -> Term:
     """Build a :class:`Term` with its columns and prior.
 
     The columns depend on the candidate, its parameter and the context's base model only,
     so they are kept on the context: the forward selection profiles the same grids at
-    every step.
+    every step. With ``rows``, the term holds only the rows the scorers read
+    (``ctx.extra["rows_step"]``): what a profile over a grid needs, at a fraction of the
+    memory; such a term is for scoring only.
     """
+    step = int(ctx.extra.get("rows_step", 1))
     cache = ctx.extra.setdefault(("cache", id(ctx.model)), {})
-    key = _column_key(c, h)
+    key = _column_key(c, h, step if rows else 1)
     X = cache.get(key)
     if X is None:
-        X = cache[key] = c.columns(h, ctx)
+        X = c.columns(h, ctx)
+        if rows:
+            X = rows_of(X, step)
+        cache[key] = X
     return Term(cand=c, h=h, X=X, prior=c.prior_tol(h, ctx), center=c.prior_center(h, ctx))
 
 
-def _column_key(c: Candidate, h: Any) -> tuple[Any, ...]:
-    return ("columns", c.effect, h if isinstance(h, (tuple, str)) or h is None else float(h))
+def _column_key(c: Candidate, h: Any, step: int = 1) -> tuple[Any, ...]:
+    return ("columns", c.effect, h if isinstance(h, (tuple, str)) or h is None else float(h),
+            step)
 
 
 #: Most column bytes built in one parallel batch.
@@ -284,13 +340,15 @@ _BATCH_BYTES = 64 * 2**20
 
 def prefetch(c: Candidate, hs: Any, ctx: Context) -> None:
     """Build the missing columns of grid points ``hs`` in parallel batches, when the
-    candidate can (``columns_many``), into the cache :func:`make_term` reads."""
+    candidate can (``columns_many``), into the cache :func:`make_term` reads (the rows
+    the scorers read only)."""
     many = getattr(c, "columns_many", None)
     if many is None:
         return
+    step = int(ctx.extra.get("rows_step", 1))
     cache = ctx.extra.setdefault(("cache", id(ctx.model)), {})
     todo = [h if isinstance(h, tuple) else float(h) for h in hs]
-    todo = [h for h in todo if _column_key(c, h) not in cache]
+    todo = [h for h in todo if _column_key(c, h, step) not in cache]
     per = max(1, _BATCH_BYTES // (8 * max(len(ctx.sig), 1)))
     for i in range(0, len(todo), per):
         chunk = todo[i:i + per]
@@ -298,40 +356,47 @@ def prefetch(c: Candidate, hs: Any, ctx: Context) -> None:
         if cols is None:
             return
         for h, X in zip(chunk, cols):
-            cache[_column_key(c, h)] = X
+            cache[_column_key(c, h, step)] = rows_of(X, step)
 
 
 def _profile(scorer: Scorer, kept: list[Term], c: Candidate, grid: np.ndarray, ctx: Context
              ) -> tuple[Term, Evaluation]:
     """Choose a candidate's nonlinear parameter by the held-out score of the joint fit.
 
-    The score is evaluated on ``grid`` (increasing, log-spaced), then on a fine grid
-    around the best point; the whole profile is kept on the term (for intervals).
+    The score is evaluated on ``grid`` (increasing, log-spaced), then on the
+    candidate's further stages (:meth:`Candidate.next_grid`: by default a fine grid
+    around the best point); the whole profile is kept on the term (for intervals).
     """
     q = scorer.J.shape[1]
     start = q + sum(t.X.shape[1] for t in kept)
 
-    def run(hs: Any) -> list[tuple[Any, float, np.ndarray, Term, Evaluation]]:
+    on_rows = int(ctx.extra.get("rows_step", 1)) == scorer.step > 1
+
+    def run(hs: Any) -> list[tuple[Any, float, np.ndarray]]:
         prefetch(c, hs, ctx)
         out = []
         for h in hs:
             h = h if isinstance(h, tuple) else float(h)
-            term = make_term(c, h, ctx)
+            term = make_term(c, h, ctx, rows=on_rows)
             ev = scorer.evaluate(kept + [term])
-            out.append((h, ev.score, ev.beta[start:start + term.X.shape[1]].copy(),
-                        term, ev))
+            out.append((h, ev.score, ev.beta[start:start + term.X.shape[1]].copy()))
         return out
 
     rows = run(grid)
+    stage = 1
+    nxt = c.next_grid([r[:2] for r in rows], grid, stage)
+    while nxt is not None and stage < 10:
+        rows += run(nxt)
+        stage += 1
+        nxt = c.next_grid([r[:2] for r in rows], grid, stage)
     best = min(rows, key=lambda r: r[1])
-    fine = c.fine_grid(best[0], grid)
-    if fine is not None:
-        rows += run(fine)
     numeric = not isinstance(best[0], tuple)
     if numeric:
         rows.sort(key=lambda r: r[0])
     best = min(rows, key=lambda r: r[1])
-    term, ev = best[3], best[4]
+    # the chosen point with all its samples (the grid was scored on the rows read)
+    term = make_term(c, best[0], ctx)
+    ev = scorer.evaluate(kept + [term])
     term.profile = {"h": np.array([r[0] for r in rows]) if numeric else None,
                     "h_obj": [r[0] for r in rows],
                     "score": np.array([r[1] for r in rows]),
