@@ -295,23 +295,25 @@ def diagnose(
         aug, base, betas, ctx, terms = refine(model, sig, terms, dict(base0), betas, s2,
                                               names, iters=3 if terms else 2,
                                               tolerance=tolerance)
-        # a term whose share collapses in the joint refit (rms contribution under 0.2 of
-        # the noise floor) is not a finding: drop it and refit the rest
-        small = [k for k, t in enumerate(terms)
-                 if not t.minor and _rms(t.cand.columns(t.h, ctx) @ betas[k], sig.mask)
-                 < max(0.2 * noise["rms"], 0.0 if t.effect == "delay" else min_force)]
-        if small:
-            for k in small:
-                lg = next((g for g in log if g["accepted"] and g["effect"] == terms[k].effect),
-                          None)
-                if lg is not None:
-                    lg["accepted"] = False
-                    lg["why"] += ("; dropped: its contribution after the joint refit is "
-                                  "small against the noise floor")
-            keep = [k for k in range(len(terms)) if k not in small]
-            aug, base, betas, ctx, terms = refine(
-                model, sig, [terms[k] for k in keep], dict(base0), [betas[k] for k in keep],
-                s2, names, iters=3 if keep else 2, tolerance=tolerance)
+    # a term whose share collapses in the joint refit (rms contribution under 0.2 of
+    # the noise floor) is not a finding: drop it and refit the rest (the timing term
+    # keeps the form chosen above)
+    small = [k for k, t in enumerate(terms)
+             if not t.minor and _rms(t.cand.columns(t.h, ctx) @ betas[k], sig.mask)
+             < max(0.2 * noise["rms"], 0.0 if t.effect == "delay" else min_force)]
+    if small:
+        for k in small:
+            lg = next((g for g in log if g["accepted"] and g["effect"] == terms[k].effect),
+                      None)
+            if lg is not None:
+                lg["accepted"] = False
+                lg["why"] += ("; dropped: its contribution after the joint refit is "
+                              "small against the noise floor")
+        keep = [k for k in range(len(terms)) if k not in small]
+        aug, base, betas, ctx, terms = refine(
+            model, sig, [terms[k] for k in keep], dict(base0), [betas[k] for k in keep],
+            s2, names, iters=3 if keep else 2, tolerance=tolerance)
+        alternatives = {keep.index(k): v for k, v in alternatives.items() if k in keep}
 
     # 5. evidence and report
     r1 = R.residual(aug, sig)

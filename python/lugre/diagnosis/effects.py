@@ -378,7 +378,7 @@ class Lag(Candidate):
 
     def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
         tau = float(beta[0])
-        zoh = 0.5 * ctx.sig.dt
+        zoh = 0.5 * ctx.sig.info.get("dt_logged", ctx.sig.dt)
         return (f"The force follows the recorded current by {tau * 1e3:.2g} ms on average "
                 f"(effective delay); if the current was logged at the rate the controller "
                 f"updates it, {zoh * 1e3:.2g} ms of this is the zero-order hold of the "
@@ -386,7 +386,8 @@ class Lag(Candidate):
 
     def uncertainty(self, term: Any, beta: np.ndarray, ctx: Context, sig: Signals,
                     s2: float) -> dict[str, Any]:
-        return {"effective_delay_s": float(beta[0]), "zero_order_hold_s": 0.5 * sig.dt}
+        zoh = 0.5 * sig.info.get("dt_logged", sig.dt)
+        return {"effective_delay_s": float(beta[0]), "zero_order_hold_s": zoh}
 
 
 class Drag(Candidate):

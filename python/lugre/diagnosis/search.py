@@ -533,7 +533,7 @@ def forward_select(
     log: list[dict[str, Any]] = []
     step = 0
     q = scorer.J.shape[1]
-    dt = ctx.sig.dt
+    dt = ctx.sig.info.get("dt_logged", ctx.sig.dt)  # the record's own sample interval
     m = scorer.mask
     while sum(not t.minor for t in terms) < max_terms and len(terms) < max_terms + 4:
         step += 1
