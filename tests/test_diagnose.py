@@ -262,3 +262,30 @@ def test_fast_sampling_keeps_the_band_the_position_reading_allows(effect):
     # alone give (a flat floor read 0.04 N where they give 0.056 N)
     noise = dg.noise
     assert 0.85 < noise["rms"] / noise["expected_rms"] < 1.3
+
+
+def test_resonance_search_stays_in_its_box():
+    # the staged search walks the lattice from the best point; it must not walk out of
+    # the band or into overdamped couplings (a damping ratio of 2.3 was once named)
+    from lugre.diagnosis import effects as E
+    from lugre.diagnosis import residual as R
+
+    rec, believed, _ = concealed(None, duration=4.0)
+    sig = R.prepare(rec, believed)
+    ctx = E.Context.build(sig, believed)
+    c = E.Resonance()
+    grid = c.grid(ctx)
+    top = 0.8 * sig.cutoff_hz
+    assert len(grid) == 14 and max(h[0] for h in grid) == pytest.approx(top)
+    rows = [(h, float(k)) for k, h in enumerate(grid[::-1])]  # the top frequency best
+    seen = list(rows)
+    for stage in range(1, 8):
+        nxt = c.next_grid(seen, grid, stage)
+        if nxt is None:
+            break
+        # each new point scores better the higher its frequency and damping
+        seen += [(h, -h[0] - 100 * h[1] - stage) for h in nxt]
+    hs = [h for h, _ in seen]
+    assert max(h[0] for h in hs) <= 1.13 * top + 1e-9
+    assert max(h[1] for h in hs) <= 1.6 * 0.3 + 1e-9
+    assert len(hs) < 171  # fewer load simulations than the full product grid

@@ -569,7 +569,13 @@ class Resonance(_Secant):
         grids and its refinement took 171).
         """
         fs = self.frequencies(ctx)
-        return None if fs is None else _objects([(f, 0.1, 0.6) for f in fs])
+        if fs is None:
+            return None
+        # the local search stays within what the first grids span (and a step beyond):
+        # a resonance has a light damping and lies within the filter band
+        self._box = ((0.88 * fs[0], 1.13 * fs[-1]),
+                     (0.6 * min(self.ZETAS), 1.6 * max(self.ZETAS)))
+        return _objects([(f, 0.1, 0.6) for f in fs])
 
     def next_grid(self, rows: list[tuple[Any, float]], grid: np.ndarray, stage: int
                   ) -> np.ndarray | None:
@@ -597,7 +603,9 @@ class Resonance(_Secant):
                  for c in (-0.12, 0.0, 0.12)]
         else:
             return None
-        g = [h for h in g if key(h) not in done]
+        (f_lo, f_hi), (z_lo, z_hi) = getattr(self, "_box", ((0.0, np.inf), (0.0, np.inf)))
+        g = [h for h in g if key(h) not in done
+             and f_lo <= h[0] <= f_hi and z_lo <= h[1] <= z_hi]
         if not g:
             return None  # the best point has every neighbour scored: a local optimum
         return _objects(list(dict.fromkeys(g)))
