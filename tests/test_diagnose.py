@@ -289,3 +289,39 @@ def test_resonance_search_stays_in_its_box():
     assert max(h[0] for h in hs) <= 1.13 * top + 1e-9
     assert max(h[1] for h in hs) <= 1.6 * 0.3 + 1e-9
     assert len(hs) < 171  # fewer load simulations than the full product grid
+
+
+def test_scores_read_on_every_step_th_sample_agree():
+    # a long record's held-out scores read every step-th sample: the filtered columns
+    # are band-limited, so the sums agree with the full ones (and a cogging term's
+    # gain with them)
+    from lugre.diagnosis import base as B
+    from lugre.diagnosis import effects as E
+    from lugre.diagnosis import residual as R
+    from lugre.diagnosis.search import Scorer, Term, make_term
+
+    rec, believed, _ = concealed("cogging", duration=10.0)
+    sig = R.prepare(rec, believed)
+    r0 = R.residual(believed, sig)
+    J, _, _, tol = B.base_jacobian(believed, sig, names=B.LEVELS)
+    ctx = E.Context.build(sig, believed)
+    step = sig.rows_step
+    assert step == 5
+    ctx.extra["rows_step"] = step
+    cog = next(c for c in E.candidates() if c.effect == "cogging")
+    full = make_term(cog, 0.03, ctx)
+    rows = make_term(cog, 0.03, ctx, rows=True)
+    assert rows.X.shape[0] == -(-len(sig) // step)
+    noise = R.noise_floor(r0, sig)
+    s2 = noise["rms"] ** 2 * sig.mask.sum() / noise["n_eff"]
+    s1 = Scorer(r0, J, tol, sig.mask, s2, 10)
+    s5 = Scorer(r0, J, tol, sig.mask, s2, 10, step=step)
+    for terms5, terms1 in (([], []), ([rows], [full])):
+        a, b = s1.evaluate(terms1), s5.evaluate(terms5)
+        assert b.score == pytest.approx(a.score, rel=2e-3)
+    q = J.shape[1]  # the cogging's sine and cosine amplitudes
+    assert b.beta[q:] == pytest.approx(a.beta[q:], rel=2e-3)
+    gain1 = s1.evaluate([]).score - s1.evaluate([full]).score
+    gain5 = s5.evaluate([]).score - s5.evaluate([rows]).score
+    assert gain5 == pytest.approx(gain1, rel=2e-3)
+    assert isinstance(full, Term)

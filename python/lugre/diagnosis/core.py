@@ -112,6 +112,10 @@ def _closed_loop(rec: Recording, before: Model, after: Model,
     return out
 
 
+#: Rows of a column the held-out scores read at most (longer records: every step-th).
+ROWS_KEPT = 100_000
+
+
 def diagnose(
     recording: Any,
     model: Any,
@@ -197,9 +201,11 @@ def diagnose(
     held = [k for k, n in enumerate(names) if n not in B.PRESLIDING]
     noise = R.noise_floor(r0, sig)
     s2 = noise["rms"] ** 2 * n_used / noise["n_eff"]
-    # the held-out scores read every step-th sample (all they score is band-limited);
-    # short records keep at least 200 per block
-    step = max(1, min(sig.rows_step, n_used // (200 * int(blocks))))
+    # a long record's held-out scores read every step-th sample (all they score is
+    # band-limited), so that the grid columns kept stay under about 100 000 rows each;
+    # the sums agree to a part in a thousand, but a marginal decision (a gain at its
+    # threshold) can move, so records up to that size are read whole
+    step = max(1, min(sig.rows_step, n_used // ROWS_KEPT))
     ctx.extra["rows_step"] = step
     ev_held = Scorer(r0, J[:, held], tol[held], sig.mask, s2, blocks, step=step).evaluate([])
     noise = R.noise_floor(ev_held.resid, sig)  # floor of the base-refit residual
@@ -296,11 +302,14 @@ def diagnose(
                                               names, iters=3 if terms else 2,
                                               tolerance=tolerance)
     # a term whose share collapses in the joint refit (rms contribution under 0.2 of
-    # the noise floor) is not a finding: drop it and refit the rest (the timing term
-    # keeps the form chosen above)
+    # the noise floor) is not a finding: drop it and refit the rest. Beside a timing
+    # term (refitted in its two forms above) only what falls under the practical size
+    # is dropped: the timing refit moves the other terms little, and a floor raised by
+    # broadband mismatch (EMPS) would drop a term the held-out lap confirms
+    floor = 0.0 if lag_k is not None else 0.2 * noise["rms"]
     small = [k for k, t in enumerate(terms)
-             if not t.minor and _rms(t.cand.columns(t.h, ctx) @ betas[k], sig.mask)
-             < max(0.2 * noise["rms"], 0.0 if t.effect == "delay" else min_force)]
+             if not t.minor and t.effect != "delay"
+             and _rms(t.cand.columns(t.h, ctx) @ betas[k], sig.mask) < max(floor, min_force)]
     if small:
         for k in small:
             lg = next((g for g in log if g["accepted"] and g["effect"] == terms[k].effect),
