@@ -721,8 +721,9 @@ pub fn check_resonance_step(
 
 /// Simulate the axis sampled at `t`.
 ///
-/// `keep_going` is called about every [`POLL_INTERVAL`] of run time; returning `false`
-/// stops the run with [`Error::Interrupted`].
+/// `keep_going` is called once the first few thousand plant steps are done, then about
+/// every [`POLL_INTERVAL`] of run time; returning `false` stops the run with
+/// [`Error::Interrupted`].
 ///
 /// ```
 /// use lugre::servo::{simulate, Drive, Model, SimOptions};
@@ -846,7 +847,9 @@ fn run<const EXTRAS: bool, const RK4: bool>(
     };
     let mut tc = ctrl_time(0);
     let mut since_check = 0usize;
-    let mut last_poll = Instant::now();
+    // `None` until the first poll, so a run that is stopped before it starts ends within
+    // its first POLL_STEPS steps whatever the speed of the machine.
+    let mut last_poll: Option<Instant> = None;
     loop {
         if time >= tc - tol {
             // controller (or open-loop command) update
@@ -972,11 +975,11 @@ fn run<const EXTRAS: bool, const RK4: bool>(
         since_check += m;
         if since_check >= POLL_STEPS {
             since_check = 0;
-            if last_poll.elapsed() >= POLL_INTERVAL {
+            if last_poll.is_none_or(|p| p.elapsed() >= POLL_INTERVAL) {
                 if !keep_going() {
                     return Err(Error::Interrupted);
                 }
-                last_poll = Instant::now();
+                last_poll = Some(Instant::now());
             }
         }
     }
