@@ -19,8 +19,10 @@
 //! step by the NumPy twin `lugre.reference.InverseRecord`.
 
 mod filter;
+mod spectrum;
 
 pub use filter::Lowpass;
+pub use spectrum::{position_sums, PositionSums, MAX_FREQUENCIES, RESEED};
 
 use crate::error::{check_finite, check_len, Error, Result};
 use crate::friction::{LugreParams, StaticSet};
