@@ -2,7 +2,9 @@
 
 Run: ``python benches/diagnosis_kernel.py`` (a 20 s, 20 000-sample concealed-cogging
 record from :mod:`lugre.diagnosis.synth`; best of 20 calls of the core and SciPy, best
-of 2 of the NumPy twin).
+of 2 of the NumPy twin). The last lines: the periodogram over position
+(``position_sums``, the cogging pitch search and the localisation) in the core against
+the NumPy outer products it replaced and against its twin.
 """
 
 from __future__ import annotations
@@ -69,6 +71,36 @@ def main() -> None:
     t2 = best(lambda: sig.kernel.residuals(models), 3)
     print(f"16 resonance residuals: one by one {t1 * 1e3:.0f} ms, batch {t2 * 1e3:.0f} ms "
           f"({t1 / t2:.2f}x)")
+    periodogram(sig, model)
+
+
+def periodogram(sig: R.Signals, model: Any) -> None:
+    """``position_sums`` as the cogging search calls it: every 3rd sample of the record
+    (6 667), the spatial frequencies of its pitch grid, with the squares."""
+    from lugre import reference
+    from lugre._native import position_sums
+
+    r = sig.kernel.residual(model)
+    x = sig.x[sig.mask][::3]
+    rr = r[sig.mask][::3] - np.mean(r[sig.mask])
+    span = float(np.ptp(x))
+    ks = np.arange(1.5 / span, 545 * 0.25 / span, 0.25 / span)
+
+    def outer() -> None:  # the NumPy code of Cogging._power before the kernel
+        for j in range(0, ks.size, 200):
+            ph = 2.0 * np.pi * np.outer(ks[j:j + 200], x)
+            s, c = np.sin(ph), np.cos(ph)
+            (s * s).sum(1), (c * c).sum(1), (s * c).sum(1)
+            np.einsum("ij,j->i", s, rr), np.einsum("ij,j->i", c, rr)
+
+    args = (x, rr, float(ks[0]), 0.25 / span, ks.size)
+    tn = best(outer, 5)
+    tc = best(lambda: position_sums(*args, squares=True), 20)
+    tt = best(lambda: reference.position_sums(*args, squares=True), 3)
+    tc2 = best(lambda: position_sums(*args), 20)
+    print(f"periodogram, {x.size} samples x {ks.size} frequencies: core {tc * 1e3:.2f} ms "
+          f"(without the squares {tc2 * 1e3:.2f} ms), NumPy outer products "
+          f"{tn * 1e3:.1f} ms ({tn / tc:.0f}x), NumPy twin {tt * 1e3:.1f} ms")
 
 
 if __name__ == "__main__":

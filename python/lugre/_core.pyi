@@ -16,6 +16,7 @@ __all__ = [
     "load_coupling",
     "num_threads",
     "plateaus",
+    "position_sums",
     "simulate",
     "simulate_batch",
     "stribeck",
@@ -143,3 +144,12 @@ def fit_dynamic_record(
     substeps: int = 1,
     integrator: str = "exact",
 ) -> dict[str, Any]: ...
+
+def position_sums(
+    x: npt.NDArray[np.float64],
+    r: npt.NDArray[np.float64],
+    k0: float,
+    dk: float,
+    n: int,
+    squares: bool = False,
+) -> list[npt.NDArray[np.float64]]: ...

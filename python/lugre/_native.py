@@ -19,7 +19,8 @@ from .model import ModelLike, _as_model
 from .reference import _array as _ref_array
 from .reference import _check_substeps_type, _select_drive
 
-__all__ = ["friction_force", "load_coupling", "simulate", "simulate_batch", "stribeck"]
+__all__ = ["friction_force", "load_coupling", "position_sums", "simulate", "simulate_batch",
+           "stribeck"]
 
 
 def _array(name: str, a: Any) -> np.ndarray:
@@ -175,6 +176,30 @@ def load_coupling(
     n_sub = _substeps(substeps)
     f, xl, vl, z = _core.load_coupling(xx, vv, dtf, mj, sc, ex, _float("z0", z0), n_sub)
     return CouplingResult(f, xl, vl, z)
+
+
+def position_sums(x: Any, r: Any, k0: float, dk: float, n: int, *, squares: bool = False
+                  ) -> tuple[np.ndarray, ...]:
+    """Sums of ``r`` against ``sin`` and ``cos`` of ``2*pi*k_j*x`` over a uniform grid of
+    spatial frequencies ``k_j = k0 + j*dk``, ``j < n``: the periodogram of a signal over
+    position. Runs in the Rust core (the angles advanced by rotation, re-started from
+    exact values every 32 frequencies); the parameters, results and errors are those of
+    :func:`lugre.reference.position_sums`, the results equal to about 1e-13 of their
+    scale.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(S, C)``, with ``squares`` ``(S, C, SS, CC, SC)``: the sums of ``sin*r``,
+        ``cos*r``, ``sin^2``, ``cos^2`` and ``sin*cos``, each of length ``n``.
+    """
+    from ._reference_inverse import frequency_count
+
+    xx = _array("x", x)
+    rr = _array("r", r)
+    k0f, dkf = _float("k0", k0), _float("dk", dk)
+    nn = frequency_count(n)
+    return tuple(_core.position_sums(xx, rr, k0f, dkf, nn, bool(squares)))
 
 
 def _float(name: str, value: Any) -> float:

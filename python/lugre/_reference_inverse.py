@@ -11,17 +11,23 @@ and the exact sensitivities of the LuGre force to its parameters. Exported as
 from __future__ import annotations
 
 import math
+from numbers import Integral
 from typing import Any
 
 import numpy as np
 
-from .exceptions import InputError, ParameterError
+from .exceptions import InputError, ParameterError, _fmt_f64
 from .model import ModelLike, _as_model
 
-__all__ = ["COUPLING_SUBSTEPS", "InverseRecord", "parse_base_param"]
+__all__ = ["COUPLING_SUBSTEPS", "MAX_FREQUENCIES", "InverseRecord", "parse_base_param",
+           "position_sums"]
 
 #: Substeps multiplier of the load simulation behind a ``resonance``.
 COUPLING_SUBSTEPS = 4
+
+#: Most frequencies in one call of :func:`position_sums` (``MAX_FREQUENCIES`` in
+#: ``src/inverse/spectrum.rs``).
+MAX_FREQUENCIES = 1 << 26
 
 _SIDES = ("positive", "negative")
 _KEYS = ("fc", "fs", "sigma2", "vs")
@@ -419,3 +425,91 @@ class InverseRecord:
         nonzero = [bool(np.any(cols[:, j] != 0.0)) for j in range(q)]
         jac = np.column_stack([self.filt(cols[:, j]) for j in range(q)]) if q else np.zeros((n, 0))
         return force, jac, nonzero
+
+
+def frequency_count(n: Any) -> int:
+    """The ``n`` of :func:`position_sums`: an integer from 1 to :data:`MAX_FREQUENCIES`,
+    else ParameterError (the same check in front of both backends)."""
+    if isinstance(n, bool) or not isinstance(n, Integral):
+        raise ParameterError.invalid("n", n, "must be a whole number of frequencies")
+    if not 1 <= int(n) <= MAX_FREQUENCIES:
+        raise ParameterError.invalid("n", float(n), f"must be between 1 and {MAX_FREQUENCIES} "
+                                     "frequencies")
+    return int(n)
+
+
+def _number(name: str, value: Any) -> float:
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise ParameterError.invalid(name, value, "must be a finite number") from None
+
+
+def _finite_samples(name: str, a: np.ndarray) -> None:
+    bad = np.flatnonzero(~np.isfinite(a))
+    if bad.size:
+        raise InputError.at(name, f"element {bad[0]} is {_fmt_f64(float(a[bad[0]]))} : remove "
+                            "or interpolate non-finite samples")
+
+
+def position_sums(x: Any, r: Any, k0: float, dk: float, n: int, *, squares: bool = False
+                  ) -> tuple[np.ndarray, ...]:
+    """Sums of ``r`` against ``sin`` and ``cos`` of ``2*pi*k_j*x`` over a uniform grid of
+    spatial frequencies ``k_j = k0 + j*dk``, ``j < n`` (NumPy twin of
+    ``_core.position_sums``: ``sin`` and ``cos`` of the outer product, evaluated
+    directly in blocks of frequencies).
+
+    Parameters
+    ----------
+    x, r : array_like
+        Positions [m] and values, 1-D, same length, finite.
+    k0 : float
+        First spatial frequency [1/m], finite.
+    dk : float
+        Frequency step [1/m], finite and > 0.
+    n : int
+        Number of frequencies, 1 to :data:`MAX_FREQUENCIES`.
+    squares : bool, default False
+        Also return the sums of ``sin^2``, ``cos^2`` and ``sin*cos``.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(S, C)``, with ``squares`` ``(S, C, SS, CC, SC)``, each of length ``n``.
+
+    Raises
+    ------
+    InputError
+        ``x`` or ``r`` not 1-D or not finite, ``r`` of another length than ``x``.
+    ParameterError
+        ``k0`` not finite, ``dk`` not finite or <= 0, ``n`` out of range.
+    """
+    from .reference import _array
+
+    xa, ra = _array("x", x), _array("r", r)
+    k0f, dkf = _number("k0", k0), _number("dk", dk)
+    nn = frequency_count(n)
+    # the core's checks in the core's order
+    _finite_samples("x", xa)
+    if ra.size != xa.size:
+        raise InputError.at("r", f"has {ra.size} samples but x has {xa.size}: give arrays of "
+                            "the same length")
+    _finite_samples("r", ra)
+    if not math.isfinite(k0f):
+        raise ParameterError.invalid("k0", k0f, "must be a finite spatial frequency [1/m]")
+    if not (math.isfinite(dkf) and dkf > 0.0):
+        raise ParameterError.invalid("dk", dkf, "must be a finite frequency step greater "
+                                     "than zero [1/m]")
+    ks = k0f + np.arange(nn, dtype=float) * dkf
+    out = [np.empty(nn) for _ in range(5 if squares else 2)]
+    step = max(1, 2**20 // max(xa.size, 1))  # about 8 MB per block of angles
+    for j0 in range(0, nn, step):
+        ph = 2.0 * np.pi * np.outer(ks[j0:j0 + step], xa)
+        s, c = np.sin(ph), np.cos(ph)
+        out[0][j0:j0 + step] = s @ ra
+        out[1][j0:j0 + step] = c @ ra
+        if squares:
+            out[2][j0:j0 + step] = (s * s).sum(1)
+            out[3][j0:j0 + step] = (c * c).sum(1)
+            out[4][j0:j0 + step] = (s * c).sum(1)
+    return tuple(out)

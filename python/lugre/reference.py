@@ -96,6 +96,8 @@ _LAZY = {
     "diagnose": "._reference_diagnose",
     "fit_inverse_dynamics": "._reference_diagnose",
     "steady_state_points": "._reference_plateaus",
+    # the periodogram of the diagnosis (twin of lugre._native.position_sums)
+    "position_sums": "._reference_inverse",
 }
 
 

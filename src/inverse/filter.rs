@@ -77,22 +77,54 @@ impl Lowpass {
         self.sections.is_empty()
     }
 
-    /// Run the sections once over `y` in place, started at `x0` times the steady state.
-    fn run(&self, y: &mut [f64], x0: f64) {
+    /// Run the sections once over `y` in place (from the end when `backward`), started at the
+    /// first sample of that order times the steady state.
+    fn run(&self, y: &mut [f64], backward: bool) {
         let ns = self.sections.len();
-        // up to 8 sections on the stack (order 16), more on the heap
-        let mut stack = [[0.0f64; 2]; 8];
-        let mut heap = Vec::new();
-        let st: &mut [[f64; 2]] = if ns <= 8 {
-            &mut stack[..ns]
-        } else {
-            heap.resize(ns, [0.0; 2]);
-            &mut heap[..]
-        };
+        match ns {
+            1 => self.run_n::<1>(y, backward),
+            2 => self.run_n::<2>(y, backward),
+            3 => self.run_n::<3>(y, backward),
+            4 => self.run_n::<4>(y, backward),
+            _ => self.run_any(y, backward),
+        }
+    }
+
+    /// [`Lowpass::run`] with `N` sections, their coefficients and states in registers.
+    #[inline(always)]
+    fn run_n<const N: usize>(&self, y: &mut [f64], backward: bool) {
+        let mut c = [[0.0f64; 6]; N];
+        c.copy_from_slice(&self.sections[..N]);
+        let mut st = [[0.0f64; 2]; N];
+        let x0 = if backward { y[y.len() - 1] } else { y[0] };
         for (s, z) in st.iter_mut().zip(&self.zi) {
             *s = [z[0] * x0, z[1] * x0];
         }
-        for yk in y.iter_mut() {
+        let mut one = |yk: &mut f64| {
+            let mut x = *yk;
+            for j in 0..N {
+                let out = c[j][0] * x + st[j][0];
+                st[j][0] = c[j][1] * x - c[j][4] * out + st[j][1];
+                st[j][1] = c[j][2] * x - c[j][5] * out;
+                x = out;
+            }
+            *yk = x;
+        };
+        if backward {
+            y.iter_mut().rev().for_each(&mut one);
+        } else {
+            y.iter_mut().for_each(&mut one);
+        }
+    }
+
+    /// [`Lowpass::run`] with any number of sections.
+    fn run_any(&self, y: &mut [f64], backward: bool) {
+        let mut st = vec![[0.0f64; 2]; self.sections.len()];
+        let x0 = if backward { y[y.len() - 1] } else { y[0] };
+        for (s, z) in st.iter_mut().zip(&self.zi) {
+            *s = [z[0] * x0, z[1] * x0];
+        }
+        let mut one = |yk: &mut f64| {
             let mut x = *yk;
             for (c, s) in self.sections.iter().zip(st.iter_mut()) {
                 let out = c[0] * x + s[0];
@@ -101,6 +133,11 @@ impl Lowpass {
                 x = out;
             }
             *yk = x;
+        };
+        if backward {
+            y.iter_mut().rev().for_each(&mut one);
+        } else {
+            y.iter_mut().for_each(&mut one);
         }
     }
 
@@ -120,12 +157,9 @@ impl Lowpass {
         for k in 1..=edge {
             ext.push(2.0 * last - y[n - 1 - k]);
         }
-        let x0 = ext[0];
-        self.run(&mut ext, x0);
-        ext.reverse();
-        let y0 = ext[0];
-        self.run(&mut ext, y0);
-        ext.reverse();
+        // forward, then backward from the last output (SciPy reverses the signal twice)
+        self.run(&mut ext, false);
+        self.run(&mut ext, true);
         ext.drain(..edge);
         ext.truncate(n);
         ext

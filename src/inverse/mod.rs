@@ -19,12 +19,15 @@
 //! step by the NumPy twin `lugre.reference.InverseRecord`.
 
 mod filter;
+mod spectrum;
 
 pub use filter::Lowpass;
+pub use spectrum::{position_sums, PositionSums, MAX_FREQUENCIES, RESEED};
 
 use crate::error::{check_finite, check_len, Error, Result};
-use crate::friction::{friction_force_general_into, LugreParams, StaticSet};
-use crate::servo::{load_coupling, CouplingOptions, Effect, Model};
+use crate::friction::{LugreParams, StaticSet};
+use crate::servo::fast::{Fast, Power, Shape, Square};
+use crate::servo::{coupling_force, CouplingOptions, Effect, Model};
 
 /// Substeps multiplier of the load simulation behind a `resonance` (the load's bristles
 /// then trail the samples by 1/8 of an interval, not by half of one).
@@ -276,41 +279,34 @@ impl Record {
         s
     }
 
-    /// Bristle states at the samples, advanced over each interval with the velocity and
-    /// scale at its middle; with the scale at the samples (or `None`).
-    fn bristles(&self, model: &Model, exponent: Option<f64>) -> (Vec<f64>, Option<Vec<f64>>) {
-        let s = self.friction_scale(model);
-        let vh = midpoints(&self.v);
-        let sh = s.as_deref().map(midpoints);
-        let n = self.len();
-        let mut f = vec![0.0; n];
-        let mut z = vec![0.0; n];
-        friction_force_general_into(
-            &model.friction,
-            &vh,
-            &[self.dt],
-            0.0,
-            sh.as_deref(),
-            exponent,
-            &mut f,
-            Some(&mut z),
-        );
-        (z, s)
-    }
-
     /// Unfiltered LuGre force at the samples (position/drift scales and Stribeck
     /// exponent of the model included).
     pub fn base_friction(&self, model: &Model) -> Vec<f64> {
         let exponent = exponent_of(model);
-        let (z, s) = self.bristles(model, exponent);
-        let p = &model.friction;
-        let mut out = vec![0.0; self.len()];
-        for k in 0..self.len() {
-            let sc = s.as_ref().map_or(1.0, |s| s[k]);
-            out[k] = match exponent {
-                Some(e) => p.eval_shaped(z[k], self.v[k], sc, e).1,
-                None => p.eval(z[k], self.v[k], sc).1,
-            };
+        let s = self.friction_scale(model);
+        let fr = Fast::new(&model.friction, exponent);
+        match exponent {
+            None => self.lugre_force(&fr, Square, s.as_deref()),
+            Some(e) => self.lugre_force(&fr, Power(e), s.as_deref()),
+        }
+    }
+
+    /// The force at each sample `k` at `(z_k, v[k])` with `s[k]`; then `z` advanced
+    /// over the interval with the velocity and scale at its middle.
+    fn lugre_force<S: Shape>(&self, fr: &Fast, shape: S, s: Option<&[f64]>) -> Vec<f64> {
+        let n = self.len();
+        let v = &self.v[..n];
+        let s = s.map(|s| &s[..n]);
+        let mut out = vec![0.0; n];
+        let mut z = 0.0;
+        for k in 0..n {
+            let sc = s.map_or(1.0, |s| s[k]);
+            out[k] = fr.eval(shape, z, v[k], sc).1;
+            if k + 1 < n {
+                let u = 0.5 * (v[k] + v[k + 1]);
+                let su = s.map_or(1.0, |s| 0.5 * (s[k] + s[k + 1]));
+                z = fr.advance_z(z, u, fr.g(shape, u, su), self.dt);
+            }
         }
         out
     }
@@ -366,7 +362,7 @@ impl Record {
             z0: 0.0,
             substeps: COUPLING_SUBSTEPS,
         };
-        Ok(load_coupling(model, &self.x_drive, &self.v, self.dt, &opts)?.force)
+        coupling_force(model, &self.x_drive, &self.v, self.dt, &opts)
     }
 
     /// Filtered force the model needs besides the motor: `m*a + F_friction + F_effects`

@@ -3,7 +3,7 @@
 
 use super::{slice, to_py};
 use crate::error::Error;
-use crate::inverse::{BaseParam, Lowpass, Record};
+use crate::inverse::{position_sums as sums, BaseParam, Lowpass, Record};
 use crate::servo::Model;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -258,4 +258,29 @@ impl PyInverseRecord {
         let jac = columns(n, &s.columns);
         Ok((s.force.into_pyarray(py), jac.into_pyarray(py), s.nonzero))
     }
+}
+
+/// Sums of `r` against `sin` and `cos` of `2*pi*k_j*x` for `k_j = k0 + j*dk`, `j < n`:
+/// `(S, C)`, with `squares` also `(SS, CC, SC)` (see `lugre::inverse::position_sums`).
+#[pyfunction]
+#[pyo3(signature = (x, r, k0, dk, n, squares=false))]
+pub(crate) fn position_sums<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    r: PyReadonlyArray1<'py, f64>,
+    k0: f64,
+    dk: f64,
+    n: usize,
+    squares: bool,
+) -> PyResult<Vec<F64Array<'py>>> {
+    let xs = slice("x", &x).map_err(|e| to_py(py, e))?;
+    let rs = slice("r", &r).map_err(|e| to_py(py, e))?;
+    let p = py
+        .detach(|| sums(xs, rs, k0, dk, n, squares))
+        .map_err(|e| to_py(py, e))?;
+    let mut out = vec![p.s.into_pyarray(py), p.c.into_pyarray(py)];
+    if squares {
+        out.extend([p.ss, p.cc, p.sc].map(|a| a.into_pyarray(py)));
+    }
+    Ok(out)
 }

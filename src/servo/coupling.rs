@@ -23,6 +23,7 @@
 //! assert!(r.force.iter().all(|&f| f == 0.0));
 //! ```
 
+use super::fast::{Fast, Power, Shape, Square};
 use super::model::{Effect, Model};
 use super::sim::TwoMass;
 use crate::error::{check_finite, check_len, check_scale, Error, Result};
@@ -143,15 +144,6 @@ impl Coupling {
         let damp = (self.damping_rate() * dt).ceil();
         stiff.max(damp).max(1.0)
     }
-
-    #[inline(always)]
-    fn friction(&self, z: f64, v: f64, scale: f64) -> (f64, f64) {
-        let (g, f, _) = match self.exponent {
-            Some(e) => self.friction.eval_shaped(z, v, scale, e),
-            None => self.friction.eval(z, v, scale),
-        };
-        (g, f)
-    }
 }
 
 /// Check the inputs of [`load_coupling`] (in the order of the NumPy twin).
@@ -215,18 +207,6 @@ pub fn load_coupling(
 ) -> Result<LoadTrajectory> {
     let cp = Coupling::from_model(model)?;
     let n_sub = check_inputs(&cp, x, v, dt, opts)?;
-    run(&cp, x, v, dt, opts, n_sub)
-}
-
-/// The loop of [`load_coupling`] on checked inputs, `n_sub` substeps per interval.
-fn run(
-    cp: &Coupling,
-    x: &[f64],
-    v: &[f64],
-    dt: f64,
-    opts: &CouplingOptions,
-    n_sub: usize,
-) -> Result<LoadTrajectory> {
     let n = x.len();
     let mut out = LoadTrajectory {
         force: vec![0.0; n],
@@ -234,40 +214,103 @@ fn run(
         v: vec![0.0; n],
         z: vec![0.0; n],
     };
-    if n == 0 {
-        return Ok(out);
+    let load = Some((&mut out.x[..], &mut out.v[..], &mut out.z[..]));
+    run(&cp, x, v, dt, opts, n_sub, &mut out.force, load)?;
+    Ok(out)
+}
+
+/// The coupling force of [`load_coupling`] alone (the load's trajectory not kept).
+pub(crate) fn coupling_force(
+    model: &Model,
+    x: &[f64],
+    v: &[f64],
+    dt: f64,
+    opts: &CouplingOptions,
+) -> Result<Vec<f64>> {
+    let cp = Coupling::from_model(model)?;
+    let n_sub = check_inputs(&cp, x, v, dt, opts)?;
+    let mut force = vec![0.0; x.len()];
+    run(&cp, x, v, dt, opts, n_sub, &mut force, None)?;
+    Ok(force)
+}
+
+/// The load's position, velocity and bristle state at the samples.
+type LoadOut<'a> = Option<(&'a mut [f64], &'a mut [f64], &'a mut [f64])>;
+
+/// The loop of [`load_coupling`] on checked inputs, `n_sub` substeps per interval, the
+/// coupling force into `force` and the load's state into `load`.
+#[allow(clippy::too_many_arguments)]
+fn run(
+    cp: &Coupling,
+    x: &[f64],
+    v: &[f64],
+    dt: f64,
+    opts: &CouplingOptions,
+    n_sub: usize,
+    force: &mut [f64],
+    load: LoadOut<'_>,
+) -> Result<()> {
+    let fast = Fast::new(&cp.friction, cp.exponent);
+    match cp.exponent {
+        None => run_shaped(cp, &fast, Square, x, v, dt, opts, n_sub, force, load),
+        Some(e) => run_shaped(cp, &fast, Power(e), x, v, dt, opts, n_sub, force, load),
     }
+}
+
+/// [`run`] for one shape of the Stribeck curve.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn run_shaped<S: Shape>(
+    cp: &Coupling,
+    fr: &Fast,
+    shape: S,
+    x: &[f64],
+    v: &[f64],
+    dt: f64,
+    opts: &CouplingOptions,
+    n_sub: usize,
+    force: &mut [f64],
+    mut load: LoadOut<'_>,
+) -> Result<()> {
+    let n = x.len();
+    if n == 0 {
+        return Ok(());
+    }
+    let (x, v, force) = (&x[..n], &v[..n], &mut force[..n]);
     let (k, c, ml) = (cp.k, cp.c, cp.ml);
     let h = dt / n_sub as f64;
     let nf = n_sub as f64;
+    // the interpolation fractions j/n of the substeps after the first
+    let fracs: Vec<f64> = (1..n_sub).map(|j| j as f64 / nf).collect();
     let mut xl = x[0];
     let mut vl = v[0];
     let mut z = opts.z0;
+    // one substep: the plant step of the load with the motor at (xm, vm)
+    let step = |xm: f64, vm: f64, s: f64, fe: f64, xl: &mut f64, vl: &mut f64, z: &mut f64| {
+        let fs = k * (xm - *xl) + c * (vm - *vl);
+        let (g, ff) = fr.eval(shape, *z, *vl, s);
+        let al = (fs - ff - fe) / ml;
+        *z = fr.advance_z(*z, *vl, g, h);
+        *vl += al * h;
+        *xl += *vl * h;
+    };
     for i in 0..n {
         let (x0, v0) = (x[i], v[i]);
-        out.force[i] = k * (x0 - xl) + c * (v0 - vl);
-        out.x[i] = xl;
-        out.v[i] = vl;
-        out.z[i] = z;
+        force[i] = k * (x0 - xl) + c * (v0 - vl);
+        if let Some((ox, ov, oz)) = load.as_mut() {
+            ox[i] = xl;
+            ov[i] = vl;
+            oz[i] = z;
+        }
         if i + 1 == n {
             break;
         }
         let s = opts.scale.map_or(1.0, |a| a[i]);
         let fe = opts.extra.map_or(0.0, |a| a[i]);
         let (dx, dv) = (x[i + 1] - x0, v[i + 1] - v0);
-        for j in 0..n_sub {
-            let (xm, vm) = if j == 0 {
-                (x0, v0)
-            } else {
-                let f = j as f64 / nf;
-                (x0 + dx * f, v0 + dv * f)
-            };
-            let fs = k * (xm - xl) + c * (vm - vl);
-            let (g, ff) = cp.friction(z, vl, s);
-            let al = (fs - ff - fe) / ml;
-            z = cp.friction.advance_z(z, vl, g, h);
-            vl += al * h;
-            xl += vl * h;
+        step(x0, v0, s, fe, &mut xl, &mut vl, &mut z);
+        for &f in &fracs {
+            step(x0 + dx * f, v0 + dv * f, s, fe, &mut xl, &mut vl, &mut z);
         }
         if !(xl.is_finite() && vl.is_finite() && z.is_finite()) {
             return Err(Error::Data(format!(
@@ -276,7 +319,7 @@ fn run(
             )));
         }
     }
-    Ok(out)
+    Ok(())
 }
 
 #[cfg(test)]

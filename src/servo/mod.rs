@@ -1,9 +1,11 @@
 //! The servo axis: model description and simulation.
 
 pub mod coupling;
+pub(crate) mod fast;
 pub mod model;
 pub mod sim;
 
+pub(crate) use coupling::coupling_force;
 pub use coupling::{load_coupling, Coupling, CouplingOptions, LoadTrajectory};
 pub use model::{
     Axis, ControlLaw, Controller, CurrentLoop, Effect, Feedforward, FeedforwardKind, Model,

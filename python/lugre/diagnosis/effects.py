@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from ..model import Model
-from .residual import Signals, base_friction
+from .residual import Signals, base_friction, position_sums
 
 __all__ = ["Candidate", "Context", "candidates"]
 
@@ -236,11 +236,11 @@ class Cogging(Candidate):
         return min(1.0 / (20.0 * q), 0.7 * sig.cutoff_hz / max(v_slow, 1e-9))
 
     @staticmethod
-    def _power(r: np.ndarray, x: np.ndarray, ks: np.ndarray) -> np.ndarray:
-        ph = 2.0 * np.pi * np.outer(ks, x)
-        s, c = np.sin(ph), np.cos(ph)
-        ss, cc, sc = (s * s).sum(1), (c * c).sum(1), (s * c).sum(1)
-        rs, rc = np.einsum("ij,j->i", s, r), np.einsum("ij,j->i", c, r)
+    def _power(r: np.ndarray, x: np.ndarray, k0: float, dk: float, n: int,
+               sig: Any) -> np.ndarray:
+        """Power of the best sinusoid of ``r`` over ``x`` at ``k0 + j*dk``, ``j < n``
+        (least squares on sin and cos)."""
+        rs, rc, ss, cc, sc = position_sums(sig, x, r, k0, dk, n, squares=True)
         det = ss * cc - sc * sc
         bs = (cc * rs - sc * rc) / det
         bc = (ss * rc - sc * rs) / det
@@ -255,14 +255,17 @@ class Cogging(Candidate):
         step = max(1, int(m.sum() // 6000))
         x = ctx.sig.x[m][::step]
         rr = r[m][::step] - np.mean(r[m])
-        p = np.concatenate([self._power(rr, x, ks[j:j + 200])
-                            for j in range(0, ks.size, 200)])
+        dk = 0.25 / max(ctx.xrange[1] - ctx.xrange[0], 1e-9)  # the step of _kgrid
+        p = self._power(rr, x, float(ks[0]), dk, ks.size, ctx.sig)
         k0 = ks[int(np.argmax(p))]
         span = ctx.xrange[1] - ctx.xrange[0]
-        fine = np.linspace(k0 - 0.3 / span, k0 + 0.3 / span, 31)
+        lo, hi = k0 - 0.3 / span, k0 + 0.3 / span
+        fine = np.linspace(lo, hi, 31)
+        pf = self._power(rr, x, lo, (hi - lo) / 30, 31, ctx.sig)
         if lead:  # one revolution of the screw and its harmonics: always tried
             fine = np.concatenate([fine, np.arange(1, 5) / float(lead)])
-        pf = self._power(rr, x, fine)
+            kl = abs(1.0 / float(lead))  # (the power is even in k)
+            pf = np.concatenate([pf, self._power(rr, x, kl, kl, 4, ctx.sig)])
         k1 = float(fine[int(np.argmax(pf))])
         self.spectrum = (ks, p)
         return 1.0 / k1

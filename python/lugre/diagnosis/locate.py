@@ -87,11 +87,7 @@ def position_spectrum(r: np.ndarray, sig: R.Signals) -> tuple[np.ndarray, np.nda
     rr = r[m][::step] - np.mean(r[m])
     span = max(float(np.ptp(x)), 1e-9)
     ks = np.arange(1.0 / span, min(200.0 / span, 2000.0), 0.5 / span)
-    out = np.empty(ks.size)
-    for j0 in range(0, ks.size, 100):
-        kk = ks[j0:j0 + 100]
-        ph = 2 * np.pi * np.outer(kk, x)
-        s, c = np.sin(ph), np.cos(ph)
-        out[j0:j0 + 100] = 2 * np.hypot(np.einsum("ij,j->i", s, rr),
-                                         np.einsum("ij,j->i", c, rr)) / x.size
-    return ks, out
+    if ks.size == 0:
+        return ks, np.empty(0)
+    s, c = R.position_sums(sig, x, rr, float(ks[0]), 0.5 / span, ks.size)
+    return ks, 2 * np.hypot(s, c) / x.size

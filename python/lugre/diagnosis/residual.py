@@ -35,6 +35,7 @@ __all__ = [
     "lowpass",
     "model_force",
     "noise_floor",
+    "position_sums",
     "prepare",
     "residual",
 ]
@@ -638,3 +639,15 @@ def check_units(sig: Signals, model: Model) -> None:
 def as_model(m: Any) -> Model:
     """A :class:`~lugre.Model` from a model, dict or path."""
     return _as_model(m)
+
+
+def position_sums(sig: Signals, x: np.ndarray, r: np.ndarray, k0: float, dk: float, n: int,
+                  squares: bool = False) -> tuple[np.ndarray, ...]:
+    """Sums of ``r`` against ``sin`` and ``cos`` of ``2*pi*k_j*x``, ``k_j = k0 + j*dk``
+    (``j < n``), on the backend of ``sig`` (:func:`lugre._native.position_sums` or its
+    NumPy twin :func:`lugre.reference.position_sums`): ``(S, C)``, with ``squares``
+    ``(S, C, SS, CC, SC)``."""
+    backend = sig.backend
+    if backend is None:
+        from .. import _native as backend
+    return tuple(backend.position_sums(x, r, k0, dk, n, squares=squares))
