@@ -91,6 +91,21 @@ def test_force_dependent_friction_is_no_payload(plant):
     assert u is not None and any("not a payload" in s for s in u["shape"])
 
 
+def test_payload_or_force_friction_said_when_the_drive_never_brakes(plant):
+    """On sines the friction dominates and the drive almost never brakes the axis, so a
+    friction growing 5 % with the drive force equals a payload beside friction levels
+    5 % higher: the mass found comes with that look-alike and the move that separates
+    them, and mu = delta/mass is near the truth."""
+    rec, model = _case(plant, "load_friction", 0.05, 950)
+    dg = diagnose(rec, model, closed_loop=False)
+    mass = [f for f in dg.findings if f.effect == "mass"]
+    assert mass, dg.summary()
+    alt = [a for a in mass[0].alternatives if "drive force" in a["effect"]]
+    assert alt and alt[0]["parameters"]["braking_share"] < 0.05
+    assert alt[0]["parameters"]["mu"] == pytest.approx(0.05, rel=0.5)
+    assert "braking" in alt[0]["experiment"]
+
+
 def test_broadband_mismatch_is_not_noise(plant):
     """A periodic error of the position reading (5 um at a 4 mm period) crossed at
     changing speeds spreads over the whole band and raised the noise floor 14-fold: the

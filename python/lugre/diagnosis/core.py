@@ -386,6 +386,11 @@ def diagnose(
                                "(noise only, not model error)")
         if t.effect == "drift":
             unc, extra = V.drift_identifiability(t, float(sig.t[sig.mask][-1]), thr=min_gain)
+        if t.effect == "mass":
+            alt_m = V.mass_alternative(float(e0["delta"]), float(model.mass), ctx,
+                                       scorer.mask)
+            if alt_m is not None:
+                alternatives.setdefault(k, []).append(alt_m)
         if t.effect == "offset":
             alt_off, extra = V.offset_alternative(scorer, terms, ev_sel, names, tol, model,
                                                   sig, min_gain)

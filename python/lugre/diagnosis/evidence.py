@@ -30,6 +30,12 @@ EXPERIMENT = {
         "mean over the two approaches is the offset, an asymmetric Coulomb level gives "
         "holding currents that average to zero"
     ),
+    ("mass", "force_friction"): (
+        "record moves whose decelerations the drive must brake (short strokes at high "
+        "acceleration, or a vertical axis moving down): a payload is the same mass "
+        "speeding up and braking, a friction that grows with the drive force reads as a "
+        "heavier axis speeding up and a lighter one braking"
+    ),
 }
 
 #: Coulomb/static levels an offset shifts: +F forward, -F backward (the friction of the
@@ -335,6 +341,26 @@ def mass_both_ways(scorer: Scorer, terms: list[Term], k: int, ev: Any,
     out["not_payload"] = bool(max(out["speeding_up_se"], out["braking_se"]) < 0.25 * abs(full)
                               and abs(a - b) > 4.0 * se and abs(a - b) > 0.5 * abs(full))
     return out
+
+
+def mass_alternative(delta: float, mass: float, ctx: Any,
+                     mask: np.ndarray) -> dict[str, Any] | None:
+    """A named mass the record cannot tell from a friction growing with the drive force.
+
+    Where the drive almost never brakes the axis (``F*v < 0`` on under 5 % of the
+    samples), ``mu*|F|`` against the motion equals ``mu*F = mu*m*a + mu*friction``: a
+    payload ``mu*m`` beside friction levels ``mu`` higher, which the base refit takes.
+    :func:`mass_both_ways` cannot test it then; the finding says so. None when the
+    record holds enough braking, or the term is a lighter axis (``mu`` would be < 0).
+    """
+    sig = ctx.sig
+    m = mask & np.isfinite(sig.fm_f)
+    brake = float(np.mean((sig.fm_f * sig.vf)[m] < 0)) if m.any() else 0.0
+    if brake >= 0.05 or delta <= 0:
+        return None
+    return {"effect": "friction growing with the drive force (outside the vocabulary)",
+            "parameters": {"mu": float(delta / mass), "braking_share": brake},
+            "experiment": EXPERIMENT[("mass", "force_friction")]}
 
 
 def unexplained(r: np.ndarray, sig: R.Signals, floor: float, where: dict[str, Any],
