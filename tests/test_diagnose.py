@@ -141,6 +141,27 @@ def test_drift_slower_than_the_record_reports_the_rate():
     assert "not determined" in dg.findings[0].evidence
 
 
+def test_evaluate_reports_a_friction_level_change_and_an_offset():
+    """The true model leaves no level shift; a model with both Coulomb levels 8 % low
+    (friction changed since its record) and one with an added constant force show each
+    for what it is, at its size."""
+    rec, _, truth = concealed("none", duration=6.0)
+    ls = evaluate(rec, truth)["level_shift"]
+    assert not ls["significant"] and ls["kind"] is None
+    low = truth.replace(friction={**truth.friction, **{
+        d: {**truth.friction[d], "fc": 0.92 * truth.friction[d]["fc"]}
+        for d in ("positive", "negative")}})
+    ls = evaluate(rec, low)["level_shift"]
+    assert ls["kind"] == "friction level"
+    for d in ("positive", "negative"):
+        assert ls[d]["shift"] == pytest.approx(0.08 * truth.friction[d]["fc"], rel=0.25)
+    off = truth.replace(effects=[{"effect": "offset", "force": 2.0}])
+    ls = evaluate(rec, off)["level_shift"]
+    assert ls["kind"] == "constant force"
+    assert ls["positive"]["shift"] == pytest.approx(-2.0, rel=0.25)
+    assert ls["negative"]["shift"] == pytest.approx(2.0, rel=0.25)
+
+
 def test_evaluate_keys():
     rec, believed, truth = concealed("none", duration=4.0)
     e = evaluate(rec, truth)

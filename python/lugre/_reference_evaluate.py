@@ -14,7 +14,7 @@ from typing import Any
 __all__ = ["evaluate"]
 
 
-def evaluate(recording: Any, model: Any, *, cutoff_hz: float | None = None) -> dict[str, float]:
+def evaluate(recording: Any, model: Any, *, cutoff_hz: float | None = None) -> dict[str, Any]:
     """The inverse-dynamics force residual of ``model`` on ``recording``, on the NumPy
     kernel: twin of :func:`lugre.evaluate` (same parameters, result and errors).
 

@@ -330,12 +330,16 @@ def _cmd_diagnose(args: argparse.Namespace) -> int:
 
 def _cmd_evaluate(args: argparse.Namespace) -> int:
     from .diagnosis import evaluate
+    from .diagnosis.core import level_shift_text
     from .model import load_model
 
     _check_outputs({"RECORDING": args.recording, "--model": args.model}, {"--json": args.json})
     model = load_model(args.model)
     ev = evaluate(_read(args, args.recording), model)
     print(f"rms force residual {ev['rms_force']:.4g} N, nrmse {100 * ev['nrmse_force']:.3g} %")
+    shift = level_shift_text(ev.get("level_shift"))
+    if shift:
+        print(f"note: {shift}")
     _write_json(args.json, ev)
     print(f"evaluation written to {args.json}")
     return 0
