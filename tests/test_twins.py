@@ -919,9 +919,19 @@ def test_evaluate_twins_on_shared_records(case):
         warnings.simplefilter("ignore", lugre.LugreWarning)
         a = lugre.evaluate(d / "recording.csv", m)
         b = ref.evaluate(d / "recording.csv", m)
-    assert set(a) == set(b)
-    for k in a:
-        assert b[k] == pytest.approx(a[k], rel=1e-12, abs=0), k
+    assert_close_tree(a, b, rel=1e-12)
+
+
+def assert_close_tree(a, b, rel, path="evaluate"):
+    """Equal keys all the way down; numbers within rel, everything else equal."""
+    if isinstance(a, dict):
+        assert isinstance(b, dict) and set(a) == set(b), path
+        for k in a:
+            assert_close_tree(a[k], b[k], rel, f"{path}[{k!r}]")
+    elif isinstance(a, (int, float)) and not isinstance(a, bool):
+        assert b == pytest.approx(a, rel=rel, abs=0), path
+    else:
+        assert b == a, path
 
 
 def test_evaluate_twins_table_input_and_cutoff():
