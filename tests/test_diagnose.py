@@ -346,3 +346,27 @@ def test_scores_read_on_every_step_th_sample_agree():
     gain5 = s5.evaluate([]).score - s5.evaluate([rows]).score
     assert gain5 == pytest.approx(gain1, rel=2e-3)
     assert isinstance(full, Term)
+
+
+@pytest.mark.parametrize("seconds", [None, 0.0003, 0.001])
+def test_dead_time_read_beyond_the_controllers_hold(seconds):
+    # the model's 10 kHz controller holds each command for 0.1 ms, so the force follows
+    # the logged commands by 0.05 ms: the diagnosis reads the current that much later
+    # and a dead time comes back as what the drive adds beyond the hold (before, a
+    # clean 10 kHz record could show its own hold as a delay, and 0.3 ms read 0.21 ms)
+    from lugre.diagnosis.residual import command_hold
+
+    eff = None if seconds is None else {"effect": "delay", "seconds": seconds}
+    rec, believed, _ = concealed(eff, duration=6.0, rate_hz=10000.0)
+    assert command_hold(believed) == pytest.approx(0.5 / believed.controller["rate_hz"])
+    dg = diagnose(rec, believed, closed_loop=False)
+    timing = [f for f in dg.findings if f.effect in ("delay", "current_lag")]
+    if seconds is None:
+        assert timing == []
+        return
+    assert [f.effect for f in timing] == ["delay"]
+    f = timing[0]
+    assert f.parameters["seconds"] == pytest.approx(seconds, rel=0.1)
+    assert f.uncertainty["controller_hold_s"] == pytest.approx(command_hold(believed))
+    # without a controller nothing is known of a hold: none is assumed
+    assert command_hold(believed.replace(controller=None)) == 0.0

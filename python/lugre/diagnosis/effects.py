@@ -381,14 +381,24 @@ class Lag(Candidate):
 
     def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
         tau = float(beta[0])
+        hold = float(ctx.sig.info.get("hold_s", 0.0))
+        if hold > 0.0:
+            return (f"The force follows the recorded current by {tau * 1e3:.2g} ms on "
+                    f"average (effective delay) beyond the {hold * 1e3:.2g} ms by which the "
+                    "model's controller holds each command (half its period, which the "
+                    "model already holds): the drive's own delay.")
         zoh = 0.5 * ctx.sig.info.get("dt_logged", ctx.sig.dt)
         return (f"The force follows the recorded current by {tau * 1e3:.2g} ms on average "
                 f"(effective delay); if the current was logged at the rate the controller "
                 f"updates it, {zoh * 1e3:.2g} ms of this is the zero-order hold of the "
-                "logged command and the rest is the drive.")
+                "logged command and the rest is the drive (the model has no controller "
+                "whose hold would say).")
 
     def uncertainty(self, term: Any, beta: np.ndarray, ctx: Context, sig: Signals,
                     s2: float) -> dict[str, Any]:
+        hold = float(sig.info.get("hold_s", 0.0))
+        if hold > 0.0:  # the controller's hold is in the model: the delay is beyond it
+            return {"effective_delay_s": float(beta[0]), "controller_hold_s": hold}
         zoh = 0.5 * sig.info.get("dt_logged", sig.dt)
         return {"effective_delay_s": float(beta[0]), "zero_order_hold_s": zoh}
 

@@ -276,6 +276,23 @@ def check_recording(rec: Recording, model: Model | None = None) -> None:
         )
 
 
+def command_hold(model: Model) -> float:
+    """Mean delay [s] of the force behind a logged current command that the model's
+    controller holds between its updates: half its period (zero-order hold).
+
+    The simulation holds each command until the next update, so the force follows the
+    commands sampled at the update instants by half a controller period on average;
+    the diagnosis reads the record the same way (:func:`prepare`), so that a ``delay``
+    it finds is what the drive adds beyond the hold, as the simulation needs it. Zero
+    without a controller (nothing known of a hold: a timing finding then includes it)
+    or with a current loop (the logged current is then the measured one).
+    """
+    c = model.controller
+    if c is None or model.to_dict()["axis"].get("current_loop") is not None:
+        return 0.0
+    return 0.5 / float(c["rate_hz"])
+
+
 def prepare(
     rec: Recording,
     model: Model,
@@ -312,7 +329,13 @@ def prepare(
     fs = 1.0 / dt
     force_raw = rec.force(model)
     fm, spikes = hampel(force_raw)
+    # the noise levels are read from the force as logged: the interpolation that
+    # moves it by the controller's hold would smooth its noise near Nyquist
     limit = reading_band(rec.x, fm, fs, float(model.mass))
+    fm_logged = fm
+    hold = command_hold(model)
+    if hold > 0.0:  # the force the held commands give, at the sample instants
+        fm = np.interp(rec.t - hold, rec.t, fm)
     if cutoff_hz is not None:
         fc = float(cutoff_hz)
     else:
@@ -333,6 +356,7 @@ def prepare(
         # band; averaged, the motion in the band changes by (pi*f*step*dt)^2/6, 2e-3
         # at 62 Hz and 10 kHz)
         fm, xr = window_mean(fm), window_mean(rec.x)
+        fm_logged = window_mean(fm_logged) if hold > 0.0 else fm
         spikes = np.add.reduceat(spikes.astype(int), centre - step // 2)[:m] > 0
         force_raw = force_raw[centre]
         tr = rec.t[centre] - 0.5 * rec.dt  # the windows' centres
@@ -377,7 +401,8 @@ def prepare(
                    force_raw=force_raw, recording=rec,
                    info={"drive_cutoff_hz": fd, "quantum": q, "edge": edge, "x_drive": xd,
                          "filter": (sos, padlen), "reading_band_hz": limit,
-                         "decimation": step, "dt_logged": rec.dt,
+                         "decimation": step, "dt_logged": rec.dt, "hold_s": hold,
+                         "fm_logged": np.asarray(fm_logged, float),
                          "cutoff_default": cutoff_hz is None},
                    kernel=kernel, backend=mod)
 
@@ -596,7 +621,7 @@ def expected_floor(sig: Signals, model: Model) -> dict[str, float]:
     """
     ff, f2 = filter_power(sig)
     df = ff[1] - ff[0]
-    level = hf_level(sig.fm[sig.mask], sig.fs)
+    level = hf_level(sig.info.get("fm_logged", sig.fm)[sig.mask], sig.fs)
     vi = 0.0 if level is None else level * float(np.sum(f2)) * df
     q = float(sig.info.get("quantum", 0.0))
     # one-sided density of the reading's noise (at the logged rate: a record read at a

@@ -47,7 +47,9 @@ def smoothing_gain(sig: R.Signals, bandwidth: float, n: int, s2: float) -> float
     time: 19 units of 15 measured; a 90 Hz lag on the generator: 46 of 41): the
     forms are told apart by what remains.
     """
-    level = R.hf_level(sig.fm[sig.mask], sig.fs) if bandwidth > 0 else None
+    if bandwidth <= 0:
+        return 0.0
+    level = R.hf_level(sig.info.get("fm_logged", sig.fm)[sig.mask], sig.fs)
     if level is None:
         return 0.0
     ff, f2 = R.filter_power(sig)
