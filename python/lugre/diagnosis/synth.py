@@ -102,7 +102,7 @@ def concealed(
     # samples at the record's rate.
     over = max(1, round(d["controller"]["rate_hz"] / rate_hz))
     tf = np.arange(n * over) / (rate_hz * over)
-    sf = simulate(truth, tf, reference_trajectory(tf, seed))
+    sf = simulate(truth, tf, reference_trajectory(tf, seed), integrator="rk4")
     xr = reference_trajectory(t, seed)
 
     class _S:
@@ -209,7 +209,7 @@ def case(truth_effects: list[dict[str, Any]], *, seed: int, axis_seed: int | Non
         n = int(duration * rate_hz)
         tf = np.arange(n * over) / (rate_hz * over)
         stroke = 0.15 if axis_seed is None else float(rng.uniform(0.05, 0.3))
-        sf = simulate(truth, tf, trajectory(kind, tf, s, stroke))
+        sf = simulate(truth, tf, trajectory(kind, tf, s, stroke), integrator="rk4")
         t = tf[::over]
         i = sf.i[::over] + current_noise * rng.standard_normal(t.size)
         x = np.round(sf.x[::over] / quantum) * quantum
