@@ -439,7 +439,7 @@ def compare(cur: Evaluation, new: Evaluation, s2: float) -> dict[str, float]:
     -------
     dict
         ``gain`` (score gain), ``t`` and ``p`` (one-sided t-test over the blocks),
-        ``positive`` (blocks with a gain), ``ratio`` (sum of positive over sum of
+        ``positive`` (blocks with a gain), ``blocks``, ``ratio`` (sum of positive over sum of
         negative block gains).
     """
     K = cur.sse_b.size
@@ -456,7 +456,7 @@ def compare(cur: Evaluation, new: Evaluation, s2: float) -> dict[str, float]:
     neg = float(-d[d < 0].sum())
     fit_gain = float((cur.sse_b.sum() - new.sse_b.sum()) / s2)
     prior_gain = float(cur.prior - new.prior)
-    return {"gain": gain, "t": t, "p": p, "positive": int(np.sum(d > 0)),
+    return {"gain": gain, "t": t, "p": p, "positive": int(np.sum(d > 0)), "blocks": int(d.size),
             "ratio": pos / neg if neg > 0 else float("inf"), "fit_gain": fit_gain,
             "prior_gain": prior_gain,
             "p_prior": float(stats.chi2.sf(max(prior_gain, 0.0), 1))}
@@ -581,9 +581,23 @@ def forward_select(
                 ok, why = False, "contribution small against the noise floor"
             if ok and contrib < min_force and c.effect != "delay":
                 # (timing matters for the loop's phase margin, not for its force rms)
-                ok, minor = False, why == "consistent over blocks"
+                # a minor correction is not named, only kept from leaking into other
+                # terms: consistent at ten times the naming level, in nine of ten blocks
+                minor = ok and (why == "consistent over blocks" or (
+                    evid["p"] < 10.0 * alpha and evid["positive"] >= 0.9 * evid["blocks"]))
+                ok = False
                 why = (f"contribution {contrib:.2g} N rms is under {min_force:.2g} N, "
                        "0.3 % of the motor force: real perhaps, but too small to matter")
+            if (not ok and c.effect == "mass" and evid["gain"] >= min_gain
+                    and contrib < min_force and evid["p"] < 10.0 * alpha
+                    and evid["positive"] >= 0.9 * evid["blocks"]):
+                # the believed mass is never exact (1-2 %), and a mass error left out
+                # leaks into whatever follows the force's changes: a 6 s record with the
+                # mass 1.3 % off read a 0.3 ms dead time as 0.2 ms. A small mass
+                # correction nearly consistent over the blocks enters as minor, never
+                # named; the naming test is the usual one
+                minor = True
+                why += "; a small mass correction, nearly consistent over the blocks"
             log.append({"step": step, "effect": c.effect, "h": h, **evid, "contrib": contrib,
                         "accepted": False, "ok": ok, "why": why})
             if (ok or minor) and (best is None or evid["gain"] > best[0]):
