@@ -370,3 +370,27 @@ def test_dead_time_read_beyond_the_controllers_hold(seconds):
     assert f.uncertainty["controller_hold_s"] == pytest.approx(command_hold(believed))
     # without a controller nothing is known of a hold: none is assumed
     assert command_hold(believed.replace(controller=None)) == 0.0
+
+
+@pytest.mark.parametrize("eff", [{"effect": "current_lag", "bandwidth": 200.0},
+                                 {"effect": "deadband", "current": 0.02}])
+def test_lookalikes_decided_by_their_exact_forms(eff):
+    # a 200 Hz current lag logged at 10 kHz and an amplifier dead-band both act where
+    # the current swings through zero; by its linearised gain the dead-band came first
+    # and a lag was named a dead-band (14 mA). Refitted exactly, each story is told by
+    # the one that fits: the lag's family for the lag, the dead-band for the dead-band
+    rec, believed, _ = concealed(eff, duration=10.0, rate_hz=10000.0)
+    dg = diagnose(rec, believed, closed_loop=False)
+    names = [f.effect for f in dg.findings]
+    if eff["effect"] == "deadband":
+        assert names == ["deadband"]
+        assert dg.findings[0].parameters["current"] == pytest.approx(0.02, rel=0.1)
+        return
+    assert len(names) == 1 and names[0] in ("delay", "current_lag")
+    f = dg.findings[0]
+    # the same mean delay whichever form: 1/(2 pi 200 Hz) = 0.8 ms
+    delay = (f.parameters["seconds"] if f.effect == "delay"
+             else 1.0 / (2 * np.pi * f.parameters["bandwidth"]))
+    assert delay == pytest.approx(1.0 / (2 * np.pi * 200.0), rel=0.2)
+    trials = [g for g in dg.trials if g["effect"] == "deadband" and g["step"] == 1]
+    assert trials and trials[0]["ok"]  # the dead-band did pass: the exact forms decided
