@@ -372,6 +372,16 @@ fn fit_rows(xr: &[f64], p: usize, y: &[f64], opts: &LinearIrlsOptions) -> Result
                 ))
             });
         }
+        if let Some(j) = rhs.iter().position(|v| !v.is_finite()) {
+            return Err(Error::input(
+                "y",
+                format!(
+                    "the fit overflows (X^T W y is {} in column {j}): scale y and the \
+                     columns of X to moderate values",
+                    rhs[j]
+                ),
+            ));
+        }
         let lambda = RIDGE * trace;
         for j in 0..p {
             g[j * p + j] += lambda;
