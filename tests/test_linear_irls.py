@@ -52,7 +52,8 @@ def assert_same_fit(a, b):
 
 
 @settings(max_examples=60, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 400), p=st.integers(1, 10),
+@given(seed=st.integers(0, 2**32 - 1),
+       n=st.one_of(st.integers(1, 60), st.integers(200, 5000)), p=st.integers(1, 10),
        share=st.sampled_from([0.0, 0.05, 0.2, 0.4]),
        weighting=st.sampled_from(["igg", "huber", "tukey", "none"]),
        rounds=st.integers(1, 9), fortran=st.booleans())
@@ -82,7 +83,8 @@ def test_twins_agree_bit_for_bit(seed, n, p, share, weighting, rounds, fortran):
 
 
 @settings(max_examples=25, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), n=st.integers(20, 600), p=st.integers(1, 6),
+@given(seed=st.integers(0, 2**32 - 1),
+       n=st.one_of(st.integers(20, 100), st.integers(500, 3000)), p=st.integers(1, 6),
        q=st.integers(1, 3), k=st.integers(0, 8), share=st.sampled_from([0.0, 0.1, 0.3]),
        ratio=st.sampled_from([0.98, 1.0, 0.5]))
 def test_grid_twins_agree_bit_for_bit(seed, n, p, q, k, share, ratio):
@@ -95,8 +97,18 @@ def test_grid_twins_agree_bit_for_bit(seed, n, p, q, k, share, ratio):
         if j % 2:
             y = y + 0.05 * c.sum(axis=1)
         extras.append(c)
-    a = _native.irls_linear_grid(X, extras, y, ratio=ratio)
-    b = ref.irls_linear_grid(X, extras, y, ratio=ratio)
+    out = []
+    for backend in BACKENDS:
+        try:
+            out.append(backend.irls_linear_grid(X, extras, y, ratio=ratio))
+        except lugre.DataError as e:
+            # few rows, many gross errors: the weights of the first fit can reject every
+            # row (residuals are weighed about zero, not about their median)
+            out.append(["refused", str(e)])
+    if isinstance(out[0], list):
+        assert out[0] == out[1]
+        return
+    a, b = out
     assert a.chosen == b.chosen and a.base_sse == b.base_sse
     np.testing.assert_array_equal(a.sse, b.sse)
     assert a.sse.shape == (k,)
