@@ -15,6 +15,9 @@ reference and output on 1001 samples.
   lugre's own exact/semi-implicit step does; both errors are printed.
 - ``lugre.simulate_batch`` on one core (process pinned with ``sched_setaffinity``) and
   on two.
+- the robust linear fit of the inverse dynamics (``irls_linear``, ``irls_linear_grid``:
+  IGG-weighted IRLS, 8 rounds) in the core against its NumPy twin and against the NumPy
+  code it replaced, on 20 000 rows with 10 % gross errors (``--only linear``);
 - ``lugre.fit_static`` against ``scipy.optimize.least_squares`` (soft-L1 loss) on the
   same points; ``lugre.fit_dynamic`` against the eq. 18 least-squares objective over
   ``lugre.reference.simulate`` driven by SciPy's Nelder-Mead.
@@ -387,15 +390,87 @@ def dynamic_fit(quick: bool) -> None:
           f"whole fit ratio {ts / tl:.1f}x")
 
 
+def linear_problem(n: int, seed: int = 0) -> tuple[np.ndarray, list[np.ndarray], np.ndarray]:
+    """``n`` rows shaped like the inverse-dynamics fit: 5 base columns (acceleration,
+    per-direction Coulomb and viscous terms), 15 candidate pairs of Stribeck humps,
+    0.3 N noise and 10 % gross errors of 3 to 30 N."""
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0.0, 20.0, n)
+    v = 0.2 * np.sin(2 * np.pi * 0.5 * t) + 0.01 * rng.standard_normal(n)
+    a = np.gradient(v, t)
+    pos, neg = (v > 0).astype(float), (v < 0).astype(float)
+    X = np.column_stack([a, pos, pos * v, -neg, neg * v])
+    extras = [np.column_stack([pos * np.exp(-(v / vs) ** 2), -neg * np.exp(-(v / vs) ** 2)])
+              for vs in 0.2 * np.logspace(-2.5, -0.5, 15)]
+    y = X @ [25.0, 20.0, 300.0, 21.0, 310.0] + extras[9] @ [30.0, 35.0]
+    y += 0.3 * rng.standard_normal(n)
+    bad = rng.random(n) < 0.1
+    y[bad] += rng.uniform(3.0, 30.0, bad.sum()) * rng.choice([-1.0, 1.0], bad.sum())
+    return X, extras, y
+
+
+def former_numpy_irls(X: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, float]:
+    """The NumPy IRLS ``diagnosis/inverse.py`` held before the core took it over."""
+    w = np.ones(X.shape[0])
+    b = np.zeros(X.shape[1])
+    for _ in range(8):
+        G = np.einsum("ij,ik,i->jk", X, X, w)
+        b = np.linalg.solve(G + 1e-12 * np.trace(G) * np.eye(G.shape[0]),
+                            np.einsum("ij,i->j", X, w * y))
+        e = y - np.einsum("ij,j->i", X, b)
+        s = 1.4826 * np.median(np.abs(e - np.median(e))) + 1e-12
+        u = np.abs(e) / s
+        w = np.where(u <= 1.5, 1.0, np.where(u <= 2.5, 1.5 / u, 0.0))
+    e = y - np.einsum("ij,j->i", X, b)
+    return b, float(np.sum(w * e * e))
+
+
+def linear_fit(quick: bool) -> None:
+    from lugre import _core, _native
+
+    n = 2000 if quick else 20000
+    X, extras, y = linear_problem(n)
+    X7 = np.column_stack([X, extras[7]])
+    rep = 3 if quick else 10
+    print(f"\nrobust linear fit (IGG IRLS, 8 rounds), {n} rows, core on "
+          f"{_core.num_threads()} threads for the grid")
+    tc, fc = best(lambda: _native.irls_linear(X7, y), rep)
+    tr, fr = best(lambda: reference.irls_linear(X7, y), rep)
+    to, (bo, _) = best(lambda: former_numpy_irls(X7, y), rep)
+    same = np.array_equal(fc.coef, fr.coef) and np.array_equal(fc.weights, fr.weights)
+    dev = float(np.max(np.abs(fc.coef - bo) / np.abs(bo)))
+    print(f"  irls_linear, 7 columns: core {tc * 1e3:7.2f} ms, NumPy twin {tr * 1e3:7.2f} ms "
+          f"({tr / tc:.1f}x), former NumPy code {to * 1e3:7.2f} ms ({to / tc:.1f}x); "
+          f"core == twin bit for bit: {same}; largest relative difference to the former "
+          f"code {dev:.1e}")
+    tc, gc = best(lambda: _native.irls_linear_grid(X, extras, y), max(rep // 2, 1))
+    tr, gr = best(lambda: reference.irls_linear_grid(X, extras, y), max(rep // 5, 1))
+
+    def former_grid() -> int | None:
+        best_sse, chosen = former_numpy_irls(X, y)[1], None
+        for k, c in enumerate(extras):
+            b, sse = former_numpy_irls(np.column_stack([X, c]), y)
+            if b[-1] > 0 and b[-2] > 0 and sse < 0.98 * best_sse:
+                best_sse, chosen = sse, k
+        return chosen
+
+    to, co = best(former_grid, max(rep // 5, 1))
+    same = gc.chosen == gr.chosen and np.array_equal(gc.fit.coef, gr.fit.coef)
+    print(f"  irls_linear_grid, 5 + 15 x 2 columns: core {tc * 1e3:7.2f} ms, NumPy twin "
+          f"{tr * 1e3:7.2f} ms ({tr / tc:.1f}x), former NumPy code {to * 1e3:7.2f} ms "
+          f"({to / tc:.1f}x); chosen {gc.chosen} / {gr.chosen} / {co}; core == twin bit for "
+          f"bit: {same}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes, fewer repeats")
-    ap.add_argument("--only", choices=["closed_loop", "batch", "static", "dynamic"],
+    ap.add_argument("--only", choices=["closed_loop", "batch", "linear", "static", "dynamic"],
                     action="append", help="run only these sections")
     a = ap.parse_args()
     print(f"lugre {lugre.__version__} | {machine()}")
-    sections = {"closed_loop": closed_loop, "batch": batch, "static": static_fit,
-                "dynamic": dynamic_fit}
+    sections = {"closed_loop": closed_loop, "batch": batch, "linear": linear_fit,
+                "static": static_fit, "dynamic": dynamic_fit}
     for name, fn in sections.items():
         if not a.only or name in a.only:
             fn(a.quick)

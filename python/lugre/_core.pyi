@@ -13,6 +13,8 @@ __all__ = [
     "fit_dynamic_record",
     "fit_static_points",
     "friction_force",
+    "irls_linear",
+    "irls_linear_grid",
     "load_coupling",
     "num_threads",
     "plateaus",
@@ -153,3 +155,17 @@ def position_sums(
     n: int,
     squares: bool = False,
 ) -> list[npt.NDArray[np.float64]]: ...
+def irls_linear(
+    x: npt.NDArray[np.float64],
+    y: npt.NDArray[np.float64],
+    weighting: str = "igg",
+    rounds: int = 8,
+) -> dict[str, Any]: ...
+def irls_linear_grid(
+    x: npt.NDArray[np.float64],
+    extras: list[npt.NDArray[np.float64]],
+    y: npt.NDArray[np.float64],
+    weighting: str = "igg",
+    rounds: int = 8,
+    ratio: float = 0.98,
+) -> dict[str, Any]: ...

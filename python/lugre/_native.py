@@ -13,14 +13,14 @@ from typing import Any
 import numpy as np
 
 from . import _core
-from ._result import CouplingResult, SimResult
+from ._result import CouplingResult, GridFit, LinearFit, SimResult
 from .exceptions import InputError
 from .model import ModelLike, _as_model
 from .reference import _array as _ref_array
 from .reference import _check_substeps_type, _select_drive
 
-__all__ = ["friction_force", "load_coupling", "position_sums", "simulate", "simulate_batch",
-           "stribeck"]
+__all__ = ["friction_force", "irls_linear", "irls_linear_grid", "load_coupling",
+           "position_sums", "simulate", "simulate_batch", "stribeck"]
 
 
 def _array(name: str, a: Any) -> np.ndarray:
@@ -200,6 +200,45 @@ def position_sums(x: Any, r: Any, k0: float, dk: float, n: int, *, squares: bool
     k0f, dkf = _float("k0", k0), _float("dk", dk)
     nn = frequency_count(n)
     return tuple(_core.position_sums(xx, rr, k0f, dkf, nn, bool(squares)))
+
+
+def irls_linear(x: Any, y: Any, *, weighting: str = "igg", rounds: int = 8) -> LinearFit:
+    """Robust linear least squares ``y ~ X b`` by IRLS, in the Rust core
+    (``estimate::irls_linear``, the interpreter released). The parameters, results and
+    errors are those of :func:`lugre.reference.irls_linear`, the results equal bit for
+    bit.
+
+    Returns
+    -------
+    LinearFit
+        ``coef``, ``weights``, ``residuals``, ``sse`` and ``scale``.
+    """
+    from ._reference_linear import fit_result, linear_args
+
+    xa, ya, name, nr = linear_args(x, y, weighting, rounds)
+    return fit_result(_core.irls_linear(np.asfortranarray(xa), np.ascontiguousarray(ya),
+                                        name, nr))
+
+
+def irls_linear_grid(x: Any, extras: Any, y: Any, *, weighting: str = "igg", rounds: int = 8,
+                     ratio: float = 0.98) -> GridFit:
+    """:func:`irls_linear` of ``x`` alone and joined by each candidate's extra columns,
+    the best kept (``estimate::irls_linear_grid``, the candidates fitted in parallel).
+    The parameters, results and errors are those of
+    :func:`lugre.reference.irls_linear_grid`, the results equal bit for bit.
+
+    Returns
+    -------
+    GridFit
+        ``chosen``, ``fit``, ``base_sse`` and ``sse``.
+    """
+    from ._reference_linear import fit_result, grid_args
+
+    xa, cands, ya, name, nr, rt = grid_args(x, extras, y, weighting, rounds, ratio)
+    d = _core.irls_linear_grid(np.asfortranarray(xa), [np.asfortranarray(c) for c in cands],
+                               np.ascontiguousarray(ya), name, nr, rt)
+    return GridFit(chosen=d["chosen"], fit=fit_result(d["fit"]), base_sse=float(d["base_sse"]),
+                   sse=d["sse"])
 
 
 def _float(name: str, value: Any) -> float:

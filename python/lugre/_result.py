@@ -1,5 +1,6 @@
 """Results shared by :mod:`lugre` (Rust core) and :mod:`lugre.reference`: a simulation's
-:class:`SimResult` and :func:`~lugre.load_coupling`'s :class:`CouplingResult`."""
+:class:`SimResult`, :func:`~lugre.load_coupling`'s :class:`CouplingResult` and the
+robust linear fits' :class:`LinearFit` and :class:`GridFit`."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-__all__ = ["CouplingResult", "SimResult"]
+__all__ = ["CouplingResult", "GridFit", "LinearFit", "SimResult"]
 
 
 class SimResult:
@@ -141,3 +142,49 @@ class CouplingResult(NamedTuple):
     x_load: np.ndarray
     v_load: np.ndarray
     z: np.ndarray
+
+
+class LinearFit(NamedTuple):
+    """A robust linear fit ``y ~ X b`` by IRLS (``irls_linear`` of ``lugre._native`` and
+    :mod:`lugre.reference`).
+
+    Attributes
+    ----------
+    coef : numpy.ndarray
+        Coefficients ``b``, one per column, from the last round's weighted solve.
+    weights : numpy.ndarray
+        Weight of each row from the residuals of ``coef`` (0: rejected).
+    residuals : numpy.ndarray
+        ``y - X b``.
+    sse : float
+        Weighted sum of squares ``sum w*e^2``.
+    scale : float
+        Scale the weights were computed at (``1.4826*MAD + 1e-12``).
+    """
+
+    coef: np.ndarray
+    weights: np.ndarray
+    residuals: np.ndarray
+    sse: float
+    scale: float
+
+
+class GridFit(NamedTuple):
+    """The best of a base design and its candidates (``irls_linear_grid``).
+
+    Attributes
+    ----------
+    chosen : int or None
+        Index of the chosen candidate, None for the base design alone.
+    fit : LinearFit
+        The chosen fit: coefficients of the base columns, then of the candidate's.
+    base_sse : float
+        Weighted sum of squares of the base design alone.
+    sse : numpy.ndarray
+        Weighted sum of squares of each candidate.
+    """
+
+    chosen: int | None
+    fit: LinearFit
+    base_sse: float
+    sse: np.ndarray

@@ -18,7 +18,8 @@ step) and meant for checking the core and for reading. Never calls :mod:`lugre._
   the residual from :class:`InverseRecord`, the NumPy twin of the inverse-dynamics
   kernel (``_reference_inverse``); :func:`diagnose` and :func:`fit_inverse_dynamics`
   (``_reference_diagnose``) share the diagnosis's orchestration and take every numeric
-  kernel from here;
+  kernel from here, among them :func:`irls_linear_grid` (``_reference_linear``, with
+  :func:`irls_linear`), the robust linear fit of the inverse dynamics;
 - :func:`load_model` and :func:`save_model` are the facade's own (Python) functions.
 
 Examples
@@ -98,6 +99,9 @@ _LAZY = {
     "steady_state_points": "._reference_plateaus",
     # the periodogram of the diagnosis (twin of lugre._native.position_sums)
     "position_sums": "._reference_inverse",
+    # the robust linear fit of the inverse dynamics (twins of lugre._native.irls_linear*)
+    "irls_linear": "._reference_linear",
+    "irls_linear_grid": "._reference_linear",
 }
 
 

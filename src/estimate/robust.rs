@@ -186,17 +186,29 @@ impl Weighting {
 }
 
 /// Median of `a` (NaN for an empty slice); NaNs are ignored.
+///
+/// The middle order statistic, or half the sum of the two middle ones, found by
+/// selection in linear time (the same values a sort gives).
 pub fn median(a: &[f64]) -> f64 {
     let mut b: Vec<f64> = a.iter().copied().filter(|x| !x.is_nan()).collect();
     if b.is_empty() {
         return f64::NAN;
     }
-    b.sort_by(|x, y| x.total_cmp(y));
     let n = b.len();
+    let (left, mid, _) = b.select_nth_unstable_by(n / 2, |x, y| x.total_cmp(y));
+    let hi = *mid;
     if n % 2 == 1 {
-        b[n / 2]
+        hi
     } else {
-        0.5 * (b[n / 2 - 1] + b[n / 2])
+        // the largest of the lower half is the order statistic n/2 - 1
+        let lo = left.iter().copied().fold(f64::NEG_INFINITY, |m, x| {
+            if x.total_cmp(&m).is_gt() {
+                x
+            } else {
+                m
+            }
+        });
+        0.5 * (lo + hi)
     }
 }
 
@@ -287,6 +299,35 @@ mod tests {
         assert!((Weighting::huber().weight(2.69) - 0.5).abs() < 1e-12);
         assert_eq!(Weighting::tukey().weight(4.685), 0.0);
         assert!((Weighting::tukey().weight(0.0) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn median_by_selection_equals_median_by_sorting() {
+        let mut s: u64 = 7;
+        for n in 1..200usize {
+            let a: Vec<f64> = (0..n)
+                .map(|k| {
+                    s = s.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+                    // ties and signed zeros among random values
+                    match k % 7 {
+                        0 => 0.0,
+                        1 => -0.0,
+                        2 => 1.5,
+                        _ => (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5,
+                    }
+                })
+                .collect();
+            let mut b = a.clone();
+            b.sort_by(|x, y| x.total_cmp(y));
+            let want = if n % 2 == 1 {
+                b[n / 2]
+            } else {
+                0.5 * (b[n / 2 - 1] + b[n / 2])
+            };
+            assert_eq!(median(&a).to_bits(), want.to_bits(), "n = {n}");
+        }
+        assert!(median(&[f64::NAN]).is_nan());
+        assert_eq!(median(&[3.0, f64::NAN, 1.0]), 2.0);
     }
 
     #[test]

@@ -4,13 +4,15 @@
 use super::{interruptible, model_of, slice, to_py};
 use crate::error::Error;
 use crate::estimate::{
-    fit_dynamic_with, fit_static, plateaus_from_recording, DirectionFit, DynamicFitOptions,
+    fit_dynamic_with, fit_static, irls_linear as irls, irls_linear_grid as irls_grid,
+    plateaus_from_recording, Design, DirectionFit, DynamicFitOptions, LinearFit, LinearIrlsOptions,
     PlateauOptions, StaticFitOptions, Weighting,
 };
 use crate::servo::Integrator;
-use numpy::{IntoPyArray, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::borrow::Cow;
 
 fn direction<'py>(py: Python<'py>, d: DirectionFit) -> PyResult<Bound<'py, PyDict>> {
     let o = PyDict::new(py);
@@ -185,5 +187,84 @@ pub(crate) fn fit_dynamic_record<'py>(
     o.set_item("iterations", r.iterations)?;
     o.set_item("evaluations", r.evaluations)?;
     o.set_item("converged", r.converged)?;
+    Ok(o)
+}
+
+/// The values of a 2-D array column by column (no copy when it is Fortran-ordered) and
+/// its number of rows.
+fn column_major<'a>(a: &'a PyReadonlyArray2<'_, f64>) -> (Cow<'a, [f64]>, usize) {
+    // the transpose is in standard (row-major) order when `a` is in Fortran order
+    let t = a.as_array().reversed_axes();
+    let rows = t.ncols();
+    match t.to_slice() {
+        Some(s) => (Cow::Borrowed(s), rows),
+        None => (Cow::Owned(t.iter().copied().collect()), rows),
+    }
+}
+
+fn linear_fit<'py>(py: Python<'py>, f: LinearFit) -> PyResult<Bound<'py, PyDict>> {
+    let o = PyDict::new(py);
+    o.set_item("coef", f.coef.into_pyarray(py))?;
+    o.set_item("weights", f.weights.into_pyarray(py))?;
+    o.set_item("residuals", f.residuals.into_pyarray(py))?;
+    o.set_item("sse", f.sse)?;
+    o.set_item("scale", f.scale)?;
+    Ok(o)
+}
+
+/// Robust linear least squares `y ~ X b` by IRLS (`estimate::irls_linear`); returns a
+/// dict (coef, weights, residuals, sse, scale).
+#[pyfunction]
+#[pyo3(signature = (x, y, weighting="igg", rounds=8))]
+pub(crate) fn irls_linear<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray2<'py, f64>,
+    y: PyReadonlyArray1<'py, f64>,
+    weighting: &str,
+    rounds: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (data, rows) = column_major(&x);
+    let r = (|| -> Result<_, Error> {
+        let opts = LinearIrlsOptions {
+            weighting: Weighting::from_name(weighting)?,
+            rounds,
+        };
+        let y = slice("y", &y)?;
+        py.detach(|| irls(Design::new(&data, rows), y, &opts))
+    })()
+    .map_err(|e| to_py(py, e))?;
+    linear_fit(py, r)
+}
+
+/// `irls_linear` of `X` alone and joined by each candidate's extra columns
+/// (`estimate::irls_linear_grid`); returns a dict (chosen, fit, base_sse, sse).
+#[pyfunction]
+#[pyo3(signature = (x, extras, y, weighting="igg", rounds=8, ratio=0.98))]
+pub(crate) fn irls_linear_grid<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray2<'py, f64>,
+    extras: Vec<PyReadonlyArray2<'py, f64>>,
+    y: PyReadonlyArray1<'py, f64>,
+    weighting: &str,
+    rounds: usize,
+    ratio: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (data, rows) = column_major(&x);
+    let extra: Vec<(Cow<[f64]>, usize)> = extras.iter().map(column_major).collect();
+    let r = (|| -> Result<_, Error> {
+        let opts = LinearIrlsOptions {
+            weighting: Weighting::from_name(weighting)?,
+            rounds,
+        };
+        let y = slice("y", &y)?;
+        let designs: Vec<Design> = extra.iter().map(|(d, n)| Design::new(d, *n)).collect();
+        py.detach(|| irls_grid(Design::new(&data, rows), &designs, y, &opts, ratio))
+    })()
+    .map_err(|e| to_py(py, e))?;
+    let o = PyDict::new(py);
+    o.set_item("chosen", r.chosen)?;
+    o.set_item("fit", linear_fit(py, r.fit)?)?;
+    o.set_item("base_sse", r.base_sse)?;
+    o.set_item("sse", r.sse.into_pyarray(py))?;
     Ok(o)
 }

@@ -370,6 +370,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(estimate::fit_static_points, m)?)?;
     m.add_function(wrap_pyfunction!(estimate::plateaus, m)?)?;
     m.add_function(wrap_pyfunction!(estimate::fit_dynamic_record, m)?)?;
+    m.add_function(wrap_pyfunction!(estimate::irls_linear, m)?)?;
+    m.add_function(wrap_pyfunction!(estimate::irls_linear_grid, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
