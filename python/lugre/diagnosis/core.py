@@ -360,7 +360,10 @@ def diagnose(
         b0 = {n: B.get_base(model, n) for n, _ in B.BASE_PARAMS}
         for n, dv in zip(names, dd):
             b0[n] += dv
-        out = refine(model, sig, tt, b0, bb, s2, names, iters=3, tolerance=tolerance)
+        try:
+            out = refine(model, sig, tt, b0, bb, s2, names, iters=3, tolerance=tolerance)
+        except ValueError:  # no valid model on the way (a coefficient out of range)
+            return np.full(len(scorer.used_blocks), np.inf)
         rr = R.residual(out[0], sig)[sig.mask]
         return np.array([np.sum(rr[b] ** 2) for b in scorer.used_blocks])
 
@@ -374,6 +377,8 @@ def diagnose(
         if not any(t.effect == other and not t.minor for t in terms_b):
             continue
         dd = (exact_sse(terms, ev) - exact_sse(terms_b, ev_b)) / s2  # > 0: the other fits
+        if not np.all(np.isfinite(dd)):
+            continue  # one story has no valid exact form: the selection stands
         tstat = abs(dd.mean()) / (dd.std(ddof=1) / math.sqrt(dd.size) + 1e-300)
         # told apart as a term is accepted: consistently over the blocks, or confined
         # (a dead-band acts where the current crosses zero) and overwhelming there

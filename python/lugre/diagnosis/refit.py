@@ -106,8 +106,18 @@ def refine(model: Model, sig: R.Signals, terms: list[Term], base: dict[str, floa
 
     # start from the linearised step of the selection, or from the model as given if
     # that is better (a step far outside the linear range can make things worse)
-    sse, aug, base, betas, ctx, r, terms = min(
-        build(base, betas, terms), build(theta0, betas, terms), key=lambda o: o[0])
+    def valid(base: dict[str, float], betas: list[np.ndarray], terms: list[Term]
+              ) -> tuple[Any, ...] | None:
+        try:
+            return build(base, betas, terms)
+        except ValueError:  # a coefficient outside the effect's range: no model there
+            return None
+
+    starts = [o for o in (valid(base, betas, terms), valid(theta0, betas, terms))
+              if o is not None]
+    if not starts:
+        build(base, betas, terms)  # raises, naming the parameter out of range
+    sse, aug, base, betas, ctx, r, terms = min(starts, key=lambda o: o[0])
     for _ in range(iters):
         J, free, _, _ = B.base_jacobian(aug, sig, names=names)
         tol = np.array([tolerance * tolrel[n] * max(abs(theta0[n]), 1e-12) for n in free])
@@ -123,8 +133,8 @@ def refine(model: Model, sig: R.Signals, terms: list[Term], base: dict[str, floa
             for n, dv in zip(free, d):
                 nb[n] = base[n] + lam * dv
             nbetas = [b + lam * db for b, db in zip(betas, dbs)]
-            out = build(nb, nbetas, terms)
-            if out[0] < sse:
+            out = valid(nb, nbetas, terms)
+            if out is not None and out[0] < sse:
                 sse, aug, base, betas, ctx, r, terms = out
                 improved = True
                 break

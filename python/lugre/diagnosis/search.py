@@ -462,6 +462,20 @@ def compare(cur: Evaluation, new: Evaluation, s2: float) -> dict[str, float]:
             "p_prior": float(stats.chi2.sf(max(prior_gain, 0.0), 1))}
 
 
+def _unphysical(c: Candidate, h: Any, beta: np.ndarray, ctx: Context) -> str | None:
+    """Why the effects a fitted term stands for are no valid model effects, or None
+    (the model's own validation: a negative drag coefficient, a dead-band under zero)."""
+    from ..exceptions import LugreError
+    from ..model import _parse_effect
+
+    try:
+        for e in c.to_effects(h, beta, ctx):
+            _parse_effect(e, "effect")
+    except (LugreError, ValueError) as err:
+        return str(err)
+    return None
+
+
 def accept(ev: dict[str, float], *, alpha: float, min_gain: float) -> tuple[bool, str]:
     """Decide on a term from :func:`compare`'s evidence.
 
@@ -565,6 +579,9 @@ def forward_select(
             # rms, not std: a constant force is a contribution too
             contrib = float(np.sqrt(np.mean(np.einsum("ij,j->i", term.X, beta)[m] ** 2)))
             minor = False
+            bad = _unphysical(c, h, beta, ctx)
+            if bad is not None:  # e.g. a negative drag: the column fits, the physics not
+                ok, why = False, f"not physical: {bad}"
             if ok and c.effect == "delay" and beta[0] < 0.2 * dt:
                 ok, why = False, (f"lag of {beta[0] * 1e3:.3g} ms is below a fifth of the "
                                   "sample interval: a timing detail of the sampled record")
