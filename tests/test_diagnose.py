@@ -448,3 +448,20 @@ def test_controller_hold_of_a_record_logged_off_its_updates():
     assert command_hold(m, 1e-3) == pytest.approx(1e-4)     # 1 kHz: every 5th update
     assert command_hold(m, 5e-4) == pytest.approx(0.5e-4)   # 2 kHz: 2.5 periods
     assert command_hold(m, 1e-4) == pytest.approx(0.5e-4)   # 10 kHz: twice per update
+
+
+def test_lag_attenuation_is_the_lags_not_a_resonance():
+    # a 64 Hz current lag on constant-speed feeds logged at 5 kHz: the selection's
+    # timing column is a pure delay, so a damped resonance took up the lag's
+    # attenuation and a mass read +0.3 kg speeding up and +2 kg braking. With every
+    # term in its exact form the lag explains it all: no resonance, no "unexplained"
+    from lugre.diagnosis.synth import case
+
+    eff = {"effect": "current_lag", "bandwidth": 64.0}
+    rec, _hold, believed, _ = case([eff], seed=20052, kind="feeds", duration=10.0,
+                                   rate_hz=5000.0, current_noise=0.0093, quantum=1e-7,
+                                   base_error=0.0106)
+    dg = diagnose(rec, believed, closed_loop=False)
+    assert [f.effect for f in dg.findings] == ["current_lag"]
+    assert dg.findings[0].parameters["bandwidth"] == pytest.approx(64.0, rel=0.15)
+    assert dg.unexplained is None

@@ -20,6 +20,7 @@ sample count nor a white-noise information criterion measures the evidence. Inst
 
 from __future__ import annotations
 
+import math
 import weakref
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -29,7 +30,7 @@ from scipy import stats
 
 from .effects import Candidate, Context
 
-__all__ = ["Evaluation", "Scorer", "Term", "forward_select"]
+__all__ = ["Evaluation", "Scorer", "Term", "forward_select", "told_apart"]
 
 
 @dataclass
@@ -474,6 +475,19 @@ def _unphysical(c: Candidate, h: Any, beta: np.ndarray, ctx: Context) -> str | N
     except (LugreError, ValueError) as err:
         return str(err)
     return None
+
+
+def told_apart(dd: np.ndarray, min_gain: float) -> tuple[bool, float]:
+    """Whether block differences of squared error (noise units) tell two fits apart, as
+    a term is accepted: consistently (t >= 3), or confined and overwhelming (over
+    ``20*min_gain``, in at least three blocks, ten times what the others lose); and t."""
+    tstat = abs(dd.mean()) / (dd.std(ddof=1) / math.sqrt(dd.size) + 1e-300)
+    sd = np.sign(dd.sum()) * dd
+    lose = float(-sd[sd < 0].sum())
+    apart = abs(dd.sum()) >= min_gain and (
+        tstat >= 3.0 or (abs(dd.sum()) > 20 * min_gain and int(np.sum(sd > 0)) >= 3
+                         and float(sd[sd > 0].sum()) > 10 * lose))
+    return bool(apart), float(tstat)
 
 
 def accept(ev: dict[str, float], *, alpha: float, min_gain: float) -> tuple[bool, str]:

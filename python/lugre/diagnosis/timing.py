@@ -21,7 +21,7 @@ from . import effects as E
 from . import residual as R
 from .evidence import EXPERIMENT
 from .refit import refine
-from .search import Term
+from .search import Term, told_apart
 
 __all__ = ["choose_timing", "effective_delay", "smoothing_gain"]
 
@@ -87,8 +87,9 @@ def choose_timing(model: Model, sig: R.Signals, terms: list[Term], k: int,
     n_b = sum(b.stop - b.start for b in blocks)
     noise_gain = smoothing_gain(sig, float(lag["bandwidth"]), n_b, s2)
     dd = dd - noise_gain / len(blocks)
-    tstat = abs(dd.mean()) / (dd.std(ddof=1) / math.sqrt(dd.size) + 1e-300)
-    separated = tstat >= 3.0 and abs(dd.sum()) >= min_gain
+    # told apart as a term is accepted: consistently, or confined (a feed's starts and
+    # stops) and overwhelming there
+    separated, _ = told_apart(dd, min_gain)
     # not separated: the record shows a time shift and nothing of the attenuation a lag
     # would add, so the pure delay is named and the lag given beside it
     better = "current_lag" if separated and dd.sum() > 0 else "delay"
