@@ -8,6 +8,7 @@ import numpy.typing as npt
 __all__ = [
     "InverseRecord",
     "Model",
+    "SimulationResult",
     "__version__",
     "check_model",
     "fit_dynamic_record",
@@ -63,6 +64,24 @@ class InverseRecord:
         self, model: _ModelArg, names: list[str]
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], list[bool]]: ...
 
+_F64: TypeAlias = npt.NDArray[np.float64]
+
+# Results: frozen, every attribute read-only; no constructor (the core makes them).
+@final
+class SimulationResult:
+    @property
+    def x(self) -> _F64: ...
+    @property
+    def v(self) -> _F64: ...
+    @property
+    def z(self) -> _F64: ...
+    @property
+    def i(self) -> _F64: ...
+    @property
+    def friction(self) -> _F64: ...
+    @property
+    def force(self) -> _F64: ...
+
 def check_model(model: _ModelArg) -> bool: ...
 def stribeck(v: npt.NDArray[np.float64], model: _ModelArg) -> npt.NDArray[np.float64]: ...
 def friction_force(
@@ -98,7 +117,7 @@ def simulate(
     z0: float = 0.0,
     x0: float | None = None,
     v0: float = 0.0,
-) -> dict[str, npt.NDArray[np.float64]]: ...
+) -> SimulationResult: ...
 def simulate_batch(
     models: list[_ModelArg],
     t: npt.NDArray[np.float64],
@@ -109,7 +128,7 @@ def simulate_batch(
     z0: float = 0.0,
     x0: float | None = None,
     v0: float = 0.0,
-) -> list[dict[str, npt.NDArray[np.float64]]]: ...
+) -> list[SimulationResult]: ...
 def num_threads() -> int: ...
 def fit_static_points(
     v: npt.NDArray[np.float64],

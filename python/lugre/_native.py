@@ -295,7 +295,8 @@ def simulate(
         ``t``, ``x``, ``v``, ``z``, ``i``, ``friction`` and ``force`` at ``t``.
     """
     tt, args = _sim_args(t, x_ref, v_ref, current, integrator, substeps, z0, x0, v0)
-    return SimResult(t=tt.copy(), **_core.simulate(_core_model(model), tt, *args))
+    r = _core.simulate(_core_model(model), tt, *args)
+    return SimResult(tt.copy(), r.x, r.v, r.z, r.i, r.friction, r.force)
 
 
 def _sim_args(t: Any, x_ref: Any, v_ref: Any, current: Any, integrator: Any, substeps: Any,
@@ -338,6 +339,6 @@ def simulate_batch(
     """
     tt, args = _sim_args(t, x_ref, v_ref, current, integrator, substeps, z0, x0, v0)
     rs = _core.simulate_batch([_core_model(m) for m in models], tt, *args)
-    return [SimResult(t=tt.copy(), **r) for r in rs]
+    return [SimResult(tt.copy(), r.x, r.v, r.z, r.i, r.friction, r.force) for r in rs]
 
 
