@@ -235,10 +235,9 @@ def irls_linear_grid(x: Any, extras: Any, y: Any, *, weighting: str = "igg", rou
     from ._reference_linear import fit_result, grid_args
 
     xa, cands, ya, name, nr, rt = grid_args(x, extras, y, weighting, rounds, ratio)
-    d = _core.irls_linear_grid(np.asfortranarray(xa), [np.asfortranarray(c) for c in cands],
+    g = _core.irls_linear_grid(np.asfortranarray(xa), [np.asfortranarray(c) for c in cands],
                                np.ascontiguousarray(ya), name, nr, rt)
-    return GridFit(chosen=d["chosen"], fit=fit_result(d["fit"]), base_sse=float(d["base_sse"]),
-                   sse=d["sse"])
+    return GridFit(chosen=g.chosen, fit=fit_result(g.fit), base_sse=g.base_sse, sse=g.sse)
 
 
 def _float(name: str, value: Any) -> float:

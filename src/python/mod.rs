@@ -354,6 +354,12 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<inverse::PyModel>()?;
     m.add_class::<inverse::PyInverseRecord>()?;
     m.add_class::<SimulationResult>()?;
+    m.add_class::<results::StaticFitResult>()?;
+    m.add_class::<results::DirectionFitResult>()?;
+    m.add_class::<results::PlateauResult>()?;
+    m.add_class::<results::DynamicFitResult>()?;
+    m.add_class::<results::LinearFitResult>()?;
+    m.add_class::<results::GridFitResult>()?;
     m.add_function(wrap_pyfunction!(check_model, m)?)?;
     m.add_function(wrap_pyfunction!(stribeck, m)?)?;
     m.add_function(wrap_pyfunction!(friction_force, m)?)?;
