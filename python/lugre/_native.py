@@ -235,10 +235,9 @@ def irls_linear_grid(x: Any, extras: Any, y: Any, *, weighting: str = "igg", rou
     from ._reference_linear import fit_result, grid_args
 
     xa, cands, ya, name, nr, rt = grid_args(x, extras, y, weighting, rounds, ratio)
-    d = _core.irls_linear_grid(np.asfortranarray(xa), [np.asfortranarray(c) for c in cands],
+    g = _core.irls_linear_grid(np.asfortranarray(xa), [np.asfortranarray(c) for c in cands],
                                np.ascontiguousarray(ya), name, nr, rt)
-    return GridFit(chosen=d["chosen"], fit=fit_result(d["fit"]), base_sse=float(d["base_sse"]),
-                   sse=d["sse"])
+    return GridFit(chosen=g.chosen, fit=fit_result(g.fit), base_sse=g.base_sse, sse=g.sse)
 
 
 def _float(name: str, value: Any) -> float:
@@ -295,7 +294,8 @@ def simulate(
         ``t``, ``x``, ``v``, ``z``, ``i``, ``friction`` and ``force`` at ``t``.
     """
     tt, args = _sim_args(t, x_ref, v_ref, current, integrator, substeps, z0, x0, v0)
-    return SimResult(t=tt.copy(), **_core.simulate(_core_model(model), tt, *args))
+    r = _core.simulate(_core_model(model), tt, *args)
+    return SimResult(tt.copy(), r.x, r.v, r.z, r.i, r.friction, r.force)
 
 
 def _sim_args(t: Any, x_ref: Any, v_ref: Any, current: Any, integrator: Any, substeps: Any,
@@ -338,6 +338,6 @@ def simulate_batch(
     """
     tt, args = _sim_args(t, x_ref, v_ref, current, integrator, substeps, z0, x0, v0)
     rs = _core.simulate_batch([_core_model(m) for m in models], tt, *args)
-    return [SimResult(t=tt.copy(), **r) for r in rs]
+    return [SimResult(tt.copy(), r.x, r.v, r.z, r.i, r.friction, r.force) for r in rs]
 
 

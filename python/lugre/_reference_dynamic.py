@@ -17,7 +17,7 @@ follows the facade wherever that handling goes.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any, Callable
 
 import numpy as np
@@ -41,6 +41,33 @@ __all__ = ["DynamicFit", "fit_dynamic"]
 
 Resid = Callable[[list[float]], "list[float] | None"]
 _LN10 = math.log(10.0)
+
+
+@dataclass(frozen=True)
+class DynamicFitResult:
+    """The fit of one record with the attributes of the core's
+    ``_core.DynamicFitResult``, which :func:`lugre.identify._dynamic_fit` reads from
+    either."""
+
+    sigma0: float
+    sigma1: float
+    std_err: list[float]
+    ci_low: list[float]
+    ci_high: list[float]
+    rel_ci_half_width: list[float]
+    identifiable: list[bool]
+    correlation: float
+    residual_autocorrelation: float
+    notes: list[str]
+    residuals: np.ndarray
+    weights: np.ndarray
+    rms_error: float
+    max_error: float
+    objective: float
+    scale: float
+    iterations: int
+    evaluations: int
+    converged: bool
 
 
 def _exp(x: float) -> float:
@@ -208,9 +235,9 @@ def _local_metric(resid: Resid, theta0: list[float], c1: float,
 def _fit_record(m: _Parsed, t: list[float], x_ref: list[float], x_meas: list[float],
                 weighting: Weighting, c1: float, c2: float, sigma0_start: float | None,
                 sigma1_start: float | None, grid: bool, max_iter: int, scale_floor: float,
-                substeps: int, integrator: str) -> dict[str, Any]:
-    """The core's ``fit_dynamic`` with default options but those given; a dict of the
-    binding's keys."""
+                substeps: int, integrator: str) -> DynamicFitResult:
+    """The core's ``fit_dynamic`` with default options but those given; the binding's
+    result."""
     tol, max_evals, s2_rel = 1e-3, 200, 0.01
     _check_time("t", t)
     for name, a in (("x_ref", x_ref), ("x_measured", x_meas)):
@@ -431,22 +458,22 @@ def _fit_record(m: _Parsed, t: list[float], x_ref: list[float], x_meas: list[flo
     for ei, wi in zip(e, w):
         if wi > 0.0:
             max_error = max(max_error, abs(ei))
-    return {
-        "sigma0": s0, "sigma1": s1, "std_err": std_err, "ci_low": ci_low,
-        "ci_high": ci_high, "rel_ci_half_width": rel, "identifiable": identifiable,
-        "correlation": correlation, "residual_autocorrelation": rho, "notes": notes,
-        "residuals": np.array(e, dtype=np.float64),
-        "weights": np.array(w, dtype=np.float64),
-        "rms_error": math.sqrt(ssq / wsum) if wsum > 0.0 else math.nan,
-        "max_error": max_error, "objective": objective(e, w), "scale": out["scale"],
-        "iterations": out["iterations"], "evaluations": evaluations,
-        "converged": out["converged"],
-    }
+    return DynamicFitResult(
+        sigma0=s0, sigma1=s1, std_err=std_err, ci_low=ci_low,
+        ci_high=ci_high, rel_ci_half_width=rel, identifiable=identifiable,
+        correlation=correlation, residual_autocorrelation=rho, notes=notes,
+        residuals=np.array(e, dtype=np.float64),
+        weights=np.array(w, dtype=np.float64),
+        rms_error=math.sqrt(ssq / wsum) if wsum > 0.0 else math.nan,
+        max_error=max_error, objective=objective(e, w), scale=out["scale"],
+        iterations=out["iterations"], evaluations=evaluations,
+        converged=out["converged"],
+    )
 
 
 def _record_call(mm: Model, rec: Recording, weighting: str, c1: float, c2: float,
                  s0: float | None, s1: float | None, grid: bool, max_iter: Any,
-                 scale_floor: float, substeps: Any, integrator: str) -> dict[str, Any]:
+                 scale_floor: float, substeps: Any, integrator: str) -> DynamicFitResult:
     """What the facade hands the core's binding, and the binding's own checks."""
     args = (str(weighting), float(c1), float(c2), s0, s1, bool(grid), _usize(max_iter),
             float(scale_floor), _usize(substeps), str(integrator))
@@ -478,7 +505,7 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
     from . import _table_or_same
 
     def twin(mm: Model, rec: Recording, s0: float | None, s1: float | None,
-             use_grid: bool) -> dict[str, Any]:
+             use_grid: bool) -> DynamicFitResult:
         return _record_call(mm, rec, weighting, c1, c2, s0, s1, use_grid, max_iter,
                             scale_floor, substeps, integrator)
 

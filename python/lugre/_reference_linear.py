@@ -104,10 +104,10 @@ def grid_args(x: Any, extras: Any, y: Any, weighting: Any, rounds: Any, ratio: A
     return xa, cands, _array("y", y), name, nr, rt
 
 
-def fit_result(d: dict[str, Any]) -> LinearFit:
-    """A :class:`LinearFit` from the core's dict."""
-    return LinearFit(coef=d["coef"], weights=d["weights"], residuals=d["residuals"],
-                     sse=float(d["sse"]), scale=float(d["scale"]))
+def fit_result(f: Any) -> LinearFit:
+    """A :class:`LinearFit` from the core's ``_core.LinearFitResult``."""
+    return LinearFit(coef=f.coef, weights=f.weights, residuals=f.residuals, sse=f.sse,
+                     scale=f.scale)
 
 
 # --------------------------------------------------------------------------------------

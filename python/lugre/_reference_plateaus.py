@@ -4,7 +4,8 @@
 :func:`plateaus` is the twin of the core's binding ``_core.plateaus``: the same checks in
 the same order, the same segmentation (runs of constant ``v_ref``, or runs of the
 velocity differentiated from ``x`` that stay near their running mean), the same
-settling rule and the same averages, with the same dict of results and the same notes.
+settling rule and the same averages, with the same results (a :class:`PlateauResult`
+with the attributes of ``_core.PlateauResult``) and the same notes.
 The running means and sums are taken in the core's order (a loop over Python floats,
 ``np.add.accumulate``), the windowed velocities elementwise, so the two agree bit for
 bit. :func:`steady_state_points` runs the facade's own orchestration
@@ -15,6 +16,7 @@ and its notes) around this kernel.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -25,9 +27,32 @@ from .identify import SteadyStatePoints, _steady_state_points
 from .io import Recording
 from .reference import _check_finite, _check_len, _check_time
 
-__all__ = ["SteadyStatePoints", "plateaus", "steady_state_points"]
+__all__ = ["PlateauResult", "SteadyStatePoints", "plateaus", "steady_state_points"]
 
 Segment = tuple[int, int, float]
+
+
+@dataclass(frozen=True)
+class PlateauResult:
+    """What :func:`plateaus` finds, with the attributes of the core's
+    ``_core.PlateauResult``, which :func:`lugre.identify._steady_state_points` reads from
+    either."""
+
+    v: np.ndarray
+    """Mean measured velocity of each point [m/s]."""
+    F: np.ndarray
+    """Mean force of each point [N]."""
+    F_std: np.ndarray
+    """Standard deviation of the force samples behind each point [N]."""
+    n_samples: list[int]
+    plateau: list[int]
+    segment_start: list[int]
+    segment_end: list[int]
+    segment_velocity: list[float]
+    segment_first_used: list[int]
+    segment_settled: list[bool]
+    used: list[bool]
+    notes: list[str]
 
 
 def _e4(x: float) -> str:
@@ -99,9 +124,9 @@ def _sum(a: np.ndarray) -> float:
 
 def plateaus(t: Any, x: Any, force: Any, v_ref: Any = None, settle_fraction: float = 0.3,
              velocity_tolerance: float = 0.02, window: int = 0, min_samples: int = 20,
-             chunks: int = 1) -> dict[str, Any]:
+             chunks: int = 1) -> PlateauResult:
     """Find the constant-velocity plateaus of a record and average each settled one
-    (twin of ``_core.plateaus``; same arguments, dict and errors).
+    (twin of ``_core.plateaus``; same arguments, results and errors).
 
     Parameters
     ----------
@@ -122,7 +147,7 @@ def plateaus(t: Any, x: Any, force: Any, v_ref: Any = None, settle_fraction: flo
 
     Returns
     -------
-    dict
+    PlateauResult
         ``v``, ``F``, ``F_std`` (arrays, one per point), ``n_samples``, ``plateau``
         (lists, one per point), ``segment_start``, ``segment_end``,
         ``segment_velocity``, ``segment_first_used``, ``segment_settled`` (lists, one per
@@ -230,20 +255,20 @@ def plateaus(t: Any, x: Any, force: Any, v_ref: Any = None, settle_fraction: flo
             f"data: no settled constant-velocity plateau found ({len(segs)} candidate "
             "segments): record longer plateaus, or give v_ref, or raise velocity_tolerance"
         )
-    return {
-        "v": np.array(v, dtype=np.float64),
-        "F": np.array(f, dtype=np.float64),
-        "F_std": np.array(f_std, dtype=np.float64),
-        "n_samples": n_samples,
-        "plateau": plateau,
-        "segment_start": [s for s, _, _ in segs],
-        "segment_end": [e for _, e, _ in segs],
-        "segment_velocity": [vn for _, _, vn in segs],
-        "segment_first_used": seg_first,
-        "segment_settled": seg_settled,
-        "used": used,
-        "notes": notes,
-    }
+    return PlateauResult(
+        v=np.array(v, dtype=np.float64),
+        F=np.array(f, dtype=np.float64),
+        F_std=np.array(f_std, dtype=np.float64),
+        n_samples=n_samples,
+        plateau=plateau,
+        segment_start=[s for s, _, _ in segs],
+        segment_end=[e for _, e, _ in segs],
+        segment_velocity=[vn for _, _, vn in segs],
+        segment_first_used=seg_first,
+        segment_settled=seg_settled,
+        used=used,
+        notes=notes,
+    )
 
 
 def steady_state_points(recording: Recording | str, force_constant: float | None = None, *,

@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -50,6 +51,30 @@ _exp = math.exp
 _MASK = 0xFFFF_FFFF_FFFF_FFFF
 
 P4 = list  # [fc, fs, sigma2, vs]
+
+
+@dataclass(frozen=True)
+class DirectionFitResult:
+    """One direction's fit with the attributes of the core's
+    ``_core.DirectionFitResult``, which :meth:`lugre.identify.DirectionFit._from_core`
+    reads from either."""
+
+    fc: float
+    fs: float
+    sigma2: float
+    vs: float
+    std_err: list[float]
+    cov: list[float]
+    ci_low: list[float]
+    ci_high: list[float]
+    indices: list[int]
+    weights: np.ndarray
+    residuals: np.ndarray
+    scale: float
+    sigma: float
+    iterations: int
+    converged: bool
+    evaluations: int
 
 
 # ---- variable projection (varpro.rs) ----------------------------------------------------
@@ -829,7 +854,7 @@ class _Paths:
 
 def _fit_direction(a: list[float], y: list[float], sign: float, indices: list[int],
                    weighting: Weighting, max_iter: int, scale_floor: float,
-                   max_start_points: int, notes: list[str], label: str) -> dict[str, Any]:
+                   max_start_points: int, notes: list[str], label: str) -> DirectionFitResult:
     fscale = max(median([abs(v) for v in y]), 1e-12)
     floor = max(scale_floor, 1e-6 * fscale)
     cfg = _Cfg(max_iter, 1e-7, floor, 4000)
@@ -895,17 +920,17 @@ def _fit_direction(a: list[float], y: list[float], sign: float, indices: list[in
     if not out.converged:
         notes.append(f"{label} direction: IRLS stopped at the iteration limit "
                      f"({out.iterations}) before the weights settled")
-    return {
-        "fc": p[0], "fs": p[1], "sigma2": p[2], "vs": p[3],
-        "std_err": std_err, "cov": cov,
-        "ci_low": [v - tq * s for v, s in zip(p, std_err)],
-        "ci_high": [v + tq * s for v, s in zip(p, std_err)],
-        "indices": indices,
-        "weights": np.array(out.weights, dtype=np.float64),
-        "residuals": np.array([sign * e for e in out.residuals], dtype=np.float64),
-        "scale": out.scale, "sigma": sigma, "iterations": out.iterations,
-        "converged": out.converged, "evaluations": out.evals,
-    }
+    return DirectionFitResult(
+        fc=p[0], fs=p[1], sigma2=p[2], vs=p[3],
+        std_err=std_err, cov=cov,
+        ci_low=[v - tq * s for v, s in zip(p, std_err)],
+        ci_high=[v + tq * s for v, s in zip(p, std_err)],
+        indices=indices,
+        weights=np.array(out.weights, dtype=np.float64),
+        residuals=np.array([sign * e for e in out.residuals], dtype=np.float64),
+        scale=out.scale, sigma=sigma, iterations=out.iterations,
+        converged=out.converged, evaluations=out.evals,
+    )
 
 
 def _usize(value: Any) -> int:
@@ -1003,7 +1028,7 @@ def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
                          "negative")
     weights = np.zeros(len(va))
     for d in (pos, neg):
-        weights[d["indices"]] = d["weights"]
+        weights[d.indices] = d.weights
     rejected = [k for k in range(len(va)) if va[k] != 0.0 and weights[k] == 0.0]
     fit = StaticFit(
         positive=DirectionFit._from_core(pos),

@@ -63,19 +63,21 @@ class DirectionFit:
     """Joint covariance of ``fc, fs, sigma2, vs`` (NaN where it cannot be computed)."""
 
     @classmethod
-    def _from_core(cls, d: dict[str, Any]) -> DirectionFit:
+    def _from_core(cls, d: Any) -> DirectionFit:
+        """From a direction's result: the core's ``_core.DirectionFitResult`` or its
+        twin's (same attributes)."""
         return cls(
-            params={k: float(d[k]) for k in STATIC_NAMES},
-            std_err=dict(zip(STATIC_NAMES, map(float, d["std_err"]))),
+            params={k: float(getattr(d, k)) for k in STATIC_NAMES},
+            std_err=dict(zip(STATIC_NAMES, map(float, d.std_err))),
             ci95={k: (float(lo), float(hi))
-                  for k, lo, hi in zip(STATIC_NAMES, d["ci_low"], d["ci_high"])},
-            indices=np.asarray(d["indices"], dtype=np.intp),
-            weights=d["weights"],
-            residuals=d["residuals"],
-            scale=float(d["scale"]),
-            iterations=int(d["iterations"]),
-            converged=bool(d["converged"]),
-            cov=np.asarray(d.get("cov", [np.nan] * 16), dtype=float).reshape(4, 4),
+                  for k, lo, hi in zip(STATIC_NAMES, d.ci_low, d.ci_high)},
+            indices=np.asarray(d.indices, dtype=np.intp),
+            weights=d.weights,
+            residuals=d.residuals,
+            scale=float(d.scale),
+            iterations=int(d.iterations),
+            converged=bool(d.converged),
+            cov=np.asarray(d.cov, dtype=float).reshape(4, 4),
         )
 
 
@@ -188,13 +190,13 @@ def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
     r = _core.fit_static_points(_array("v", v), _array("F", F), str(weighting),
                                 int(max_iter), float(scale_floor), int(max_start_points))
     fit = StaticFit(
-        positive=DirectionFit._from_core(r["positive"]),
-        negative=DirectionFit._from_core(r["negative"]),
-        weights=r["weights"],
-        rejected=list(r["rejected"]),
-        n_zero_speed=int(r["n_zero_speed"]),
-        weighting=r["weighting"],
-        notes=list(r["notes"]),
+        positive=DirectionFit._from_core(r.positive),
+        negative=DirectionFit._from_core(r.negative),
+        weights=r.weights,
+        rejected=list(r.rejected),
+        n_zero_speed=int(r.n_zero_speed),
+        weighting=r.weighting,
+        notes=list(r.notes),
     )
     if not fit.converged:
         warnings.warn("static fit: IRLS reached its iteration limit before the weights "
@@ -250,15 +252,15 @@ def steady_state_points(recording: Recording | str, force_constant: float | None
                                 min_samples=min_samples)
 
 
-def _steady_state_points(plateaus: Callable[..., dict[str, Any]],
+def _steady_state_points(plateaus: Callable[..., Any],
                          recording: Recording | str, force_constant: float | None, *,
                          columns: dict[str, str] | None, settle_fraction: float,
                          velocity_tolerance: float, chunks: int,
                          min_samples: int) -> SteadyStatePoints:
     """:func:`steady_state_points` around ``plateaus(t, x, force, v_ref, settle_fraction,
     velocity_tolerance, window, min_samples, chunks)``, the plateau detection (the core's
-    binding, or the NumPy twin's in ``lugre.reference``): the recording and its force,
-    the result and its notes."""
+    binding, or the NumPy twin's in ``lugre.reference``; both results have the same
+    attributes): the recording and its force, the result and its notes."""
     rec = recording if isinstance(recording, Recording) else read_recording(recording, columns)
     F = rec.force(force_constant)
     r = plateaus(rec.t, rec.x, np.ascontiguousarray(F, dtype=float),
@@ -266,15 +268,15 @@ def _steady_state_points(plateaus: Callable[..., dict[str, Any]],
                  float(velocity_tolerance), 0, int(min_samples), int(chunks))
     plateaus = [
         {"start": s, "end": e, "velocity": v, "first_used": f, "settled": ok}
-        for s, e, v, f, ok in zip(r["segment_start"], r["segment_end"], r["segment_velocity"],
-                                  r["segment_first_used"], r["segment_settled"])
+        for s, e, v, f, ok in zip(r.segment_start, r.segment_end, r.segment_velocity,
+                                  r.segment_first_used, r.segment_settled)
     ]
-    notes = list(r["notes"])
+    notes = list(r.notes)
     if len(notes) > 12:
         notes = notes[:10] + [(f"... and {len(notes) - 10} more plateaus skipped for the same "
                               "kind of reason (see .plateaus)")]
-    return SteadyStatePoints(v=r["v"], F=r["F"], F_std=r["F_std"], plateaus=plateaus,
-                             used=np.asarray(r["used"], dtype=bool), notes=notes)
+    return SteadyStatePoints(v=r.v, F=r.F, F_std=r.F_std, plateaus=plateaus,
+                             used=np.asarray(r.used, dtype=bool), notes=notes)
 
 
 @dataclass
@@ -418,7 +420,7 @@ def _carry_static(static_fit: StaticFit, m: Model, est: np.ndarray, lo: np.ndarr
             rr = refit(m.with_friction(**sets))
         except DataError:
             return None
-        y = np.log([rr["sigma0"], rr["sigma1"]]) - np.log(est)
+        y = np.log([rr.sigma0, rr.sigma1]) - np.log(est)
         return y if np.all(np.isfinite(y)) else None
 
     ys, xs = [], []
@@ -544,7 +546,7 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
         A parameter is not determined by the record (its notes say what would).
     """
     def core(mm: Model, rec: Recording, s0: float | None, s1: float | None,
-             use_grid: bool) -> dict[str, Any]:
+             use_grid: bool) -> Any:
         return _core.fit_dynamic_record(
             mm._core_model(), rec.t, rec.x_ref, rec.x, str(weighting), float(c1),
             float(c2), s0, s1, use_grid, int(max_iter), float(scale_floor), int(substeps),
@@ -555,14 +557,14 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
                         static_fit=static_fit, static_draws=static_draws)
 
 
-def _dynamic_fit(record_fit: Callable[..., dict[str, Any]], recording: Recording | str,
+def _dynamic_fit(record_fit: Callable[..., Any], recording: Recording | str,
                  model: ModelLike, *, sigma0_start: float | None,
                  sigma1_start: float | None, grid: bool, columns: dict[str, str] | None,
                  static_fit: StaticFit | None, static_draws: int) -> DynamicFit:
     """:func:`fit_dynamic` around ``record_fit(model, recording, sigma0_start,
     sigma1_start, grid)``, the fit of one record (the core's binding, or the NumPy twin's
-    in ``lugre.reference``): input checks, the static step's uncertainty, the result,
-    its warnings."""
+    in ``lugre.reference``; both results have the same attributes): input checks, the
+    static step's uncertainty, the result, its warnings."""
     m = _as_model(model)
     rec = recording if isinstance(recording, Recording) else read_recording(recording, columns)
     if rec.x_ref is None:
@@ -573,16 +575,16 @@ def _dynamic_fit(record_fit: Callable[..., dict[str, Any]], recording: Recording
         raise InputError.at("static_draws", f"is {static_draws!r}: give a whole number of at "
                             "least 5")
 
-    def run(mm: Model, s0: float | None, s1: float | None, use_grid: bool) -> dict[str, Any]:
+    def run(mm: Model, s0: float | None, s1: float | None, use_grid: bool) -> Any:
         return record_fit(mm, rec, s0, s1, use_grid)
 
     _check_stick_slip(rec)
     r = run(m, sigma0_start, sigma1_start, bool(grid))
     names = ("sigma0", "sigma1")
-    est = np.array([r["sigma0"], r["sigma1"]], dtype=float)
-    lo, hi = np.asarray(r["ci_low"], float), np.asarray(r["ci_high"], float)
-    notes = list(r["notes"])
-    identifiable = [bool(b) for b in r["identifiable"]]
+    est = np.array([r.sigma0, r.sigma1], dtype=float)
+    lo, hi = np.asarray(r.ci_low, float), np.asarray(r.ci_high, float)
+    notes = list(r.notes)
+    identifiable = [bool(b) for b in r.identifiable]
     if static_fit is not None:
         lo, hi, identifiable, notes = _carry_static(
             static_fit, m, est, lo, hi, identifiable, notes, int(static_draws),
@@ -599,13 +601,13 @@ def _dynamic_fit(record_fit: Callable[..., dict[str, Any]], recording: Recording
             identifiable[j] = False
     fit = DynamicFit(
         sigma0=float(est[0]), sigma1=float(est[1]),
-        std_err=dict(zip(names, map(float, r["std_err"]))),
+        std_err=dict(zip(names, map(float, r.std_err))),
         ci95={k: (float(a), float(b)) for k, a, b in zip(names, lo, hi)},
         identifiable=dict(zip(names, identifiable)),
-        correlation=float(r["correlation"]), notes=notes,
-        residuals=r["residuals"], weights=r["weights"], rms_error=float(r["rms_error"]),
-        max_error=float(r["max_error"]), iterations=int(r["iterations"]),
-        evaluations=int(r["evaluations"]), converged=bool(r["converged"]),
+        correlation=float(r.correlation), notes=notes,
+        residuals=r.residuals, weights=r.weights, rms_error=float(r.rms_error),
+        max_error=float(r.max_error), iterations=int(r.iterations),
+        evaluations=int(r.evaluations), converged=bool(r.converged),
         model=m.with_friction(sigma0=float(est[0]), sigma1=float(est[1])),
     )
     for k in names:

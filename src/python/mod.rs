@@ -9,15 +9,16 @@ use crate::servo::{self, CouplingOptions, Drive, Integrator, SimOptions, SimResu
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::RecvTimeoutError;
 use std::time::Duration;
 
 mod estimate;
 mod inverse;
+mod results;
 
 pub(crate) use inverse::model_of;
+use results::SimulationResult;
 
 /// Map a core error onto the package's exception classes (`lugre.exceptions`).
 pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
@@ -270,18 +271,7 @@ fn drive_of<'a>(kind: &str, a: &'a [f64]) -> Result<Drive<'a>, Error> {
     })
 }
 
-fn result_dict<'py>(py: Python<'py>, r: SimResult) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("x", r.x.into_pyarray(py))?;
-    d.set_item("v", r.v.into_pyarray(py))?;
-    d.set_item("z", r.z.into_pyarray(py))?;
-    d.set_item("i", r.i.into_pyarray(py))?;
-    d.set_item("friction", r.friction.into_pyarray(py))?;
-    d.set_item("force", r.force.into_pyarray(py))?;
-    Ok(d)
-}
-
-/// Simulate the axis; returns a dict of arrays (x, v, z, i, friction, force).
+/// Simulate the axis; returns a `SimulationResult` (arrays x, v, z, i, friction, force).
 ///
 /// Runs with the interpreter released and checks for Ctrl-C about every 50 ms.
 #[pyfunction]
@@ -298,7 +288,7 @@ fn simulate<'py>(
     z0: f64,
     x0: Option<f64>,
     v0: f64,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<SimulationResult> {
     let m = model_of(py, model)?;
     let run = || -> Result<SimResult, Error> {
         let opts = parse_opts(integrator, substeps, z0, x0, v0)?;
@@ -311,10 +301,11 @@ fn simulate<'py>(
         })
     };
     let r = run().map_err(|e| to_py(py, e))?;
-    result_dict(py, r)
+    Ok(SimulationResult::new(py, r))
 }
 
-/// Simulate many models on the same input in parallel; returns a list of dicts.
+/// Simulate many models on the same input in parallel; returns a list of
+/// `SimulationResult`s, one per model.
 #[pyfunction]
 #[pyo3(signature = (models, t, drive_kind, drive, integrator="exact", substeps=1, z0=0.0, x0=None, v0=0.0))]
 #[allow(clippy::too_many_arguments)]
@@ -329,7 +320,7 @@ fn simulate_batch<'py>(
     z0: f64,
     x0: Option<f64>,
     v0: f64,
-) -> PyResult<Vec<Bound<'py, PyDict>>> {
+) -> PyResult<Vec<SimulationResult>> {
     let models = models
         .iter()
         .map(|m| model_of(py, m).map(|m| (*m).clone()))
@@ -345,7 +336,10 @@ fn simulate_batch<'py>(
         .collect()
     })()
     .map_err(|e| to_py(py, e))?;
-    results.into_iter().map(|r| result_dict(py, r)).collect()
+    Ok(results
+        .into_iter()
+        .map(|r| SimulationResult::new(py, r))
+        .collect())
 }
 
 /// Number of worker threads used by batch functions.
@@ -359,6 +353,13 @@ fn num_threads() -> usize {
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<inverse::PyModel>()?;
     m.add_class::<inverse::PyInverseRecord>()?;
+    m.add_class::<SimulationResult>()?;
+    m.add_class::<results::StaticFitResult>()?;
+    m.add_class::<results::DirectionFitResult>()?;
+    m.add_class::<results::PlateauResult>()?;
+    m.add_class::<results::DynamicFitResult>()?;
+    m.add_class::<results::LinearFitResult>()?;
+    m.add_class::<results::GridFitResult>()?;
     m.add_function(wrap_pyfunction!(check_model, m)?)?;
     m.add_function(wrap_pyfunction!(stribeck, m)?)?;
     m.add_function(wrap_pyfunction!(friction_force, m)?)?;
