@@ -489,3 +489,21 @@ def test_two_effects_that_spoil_each_others_blocks_are_found_together():
     assert f.parameters["delta"] == pytest.approx(1.289, rel=0.3)
     assert any("jointly with" in g["why"] for g in dg.trials)
     assert dg.fit["holdout_after"]["rms_force"] < 0.3 * dg.fit["holdout_before"]["rms_force"]
+
+
+def test_verdict_says_when_the_refit_does_not_carry_over():
+    # a record unlike its hold-out (an unstable stretch of a resonant axis made the base
+    # refit move fc -100 %, sigma2 +800 %) made the held-out error 15 times larger while
+    # the verdict read as usual; it must say not to use the augmented model
+    from types import SimpleNamespace
+
+    from lugre.diagnosis.evidence import verdict
+
+    def dg(after):
+        return SimpleNamespace(findings=[], base_moves=[], unexplained=None,
+                               fit={"holdout_before": {"rms_force": 0.865},
+                                    "holdout_after": {"rms_force": after}})
+
+    worse, better = verdict(dg(12.9)), verdict(dg(0.5))
+    assert "does not carry over" in worse and "+1391 %" in worse
+    assert "does not carry over" not in better

@@ -568,6 +568,13 @@ def verdict(dg: Any) -> str:
     if hb and ha and hb.get("rms_force"):
         gain = (f" On the held-out record the force error goes from {hb['rms_force']:.3g} to "
                 f"{ha['rms_force']:.3g} N rms ({100 * (ha['rms_force'] / hb['rms_force'] - 1):+.0f} %).")
+        if ha["rms_force"] > 1.1 * hb["rms_force"]:
+            # the refit describes this record and not the held-out one: a record unlike
+            # its hold-out (an unstable stretch, a changed setup) or a refit gone astray
+            gain += (" The refit does not carry over to the held-out record: keep the "
+                     "model as given, and check this record against the held-out one "
+                     "(an unstable or saturated stretch, another setup or temperature) "
+                     "before using the augmented model.")
     if not dg.findings:
         txt = "Nothing found: the model leaves nothing out that this record can show."
         if dg.base_moves:
