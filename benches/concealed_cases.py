@@ -22,18 +22,23 @@ from lugre import save_model
 from lugre.diagnosis.synth import axis_model, case
 
 
-def write(out: Path, name: str, effects: list[dict], **kw) -> None:
-    rec, hold, believed, _truth = case(effects, **kw)
-    d = out / name
+def save_case(d: Path, rec, hold, believed, effects: list[dict], setup: dict,
+              fmt: str = "%.9g") -> None:
+    """One case folder in the layout of ../shared/datasets/mismatch."""
     d.mkdir(parents=True, exist_ok=True)
     for fn, r in (("recording.csv", rec), ("holdout.csv", hold)):
         cols = {"t": r.t, "x": r.x, "i": r.i, "x_ref": r.x_ref}
         np.savetxt(d / fn, np.column_stack(list(cols.values())), delimiter=",",
-                   header=",".join(cols), comments="", fmt="%.9g")
+                   header=",".join(cols), comments="", fmt=fmt)
     save_model(believed, d / "model.json")
     (d / "truth.json").write_text(json.dumps({"effects": effects, "setup": {
         k: (v if not isinstance(v, float) or math.isfinite(v) else None)
-        for k, v in kw.items()}}, indent=1))
+        for k, v in setup.items()}}, indent=1))
+
+
+def write(out: Path, name: str, effects: list[dict], **kw) -> None:
+    rec, hold, believed, _truth = case(effects, **kw)
+    save_case(out / name, rec, hold, believed, effects, kw)
 
 
 def main() -> None:

@@ -17,13 +17,12 @@ end, so nothing here was seen while the method was written.
 from __future__ import annotations
 
 import argparse
-import json
-import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from lugre import Model, save_model
+from concealed_cases import save_case  # benches/ is the script's folder
+from lugre import Model
 from lugre.diagnosis.synth import axis_model, case
 
 EFFECTS = ("cogging", "offset", "spring", "drift", "mass", "delay", "current_lag",
@@ -100,16 +99,7 @@ def write(out: Path, name: str, effects: list[str], seed: int,
     truth = [sized(e, ax, rng, stroke) for e in effects]
     sim = [{k: v for k, v in e.items() if k != "generated_as"} for e in truth]
     rec, hold, believed, _ = case(sim, seed=seed, **cond)
-    d = out / name
-    d.mkdir(parents=True, exist_ok=True)
-    for fn, r in (("recording.csv", rec), ("holdout.csv", hold)):
-        cols = {"t": r.t, "x": r.x, "i": r.i, "x_ref": r.x_ref}
-        np.savetxt(d / fn, np.column_stack(list(cols.values())), delimiter=",",
-                   header=",".join(cols), comments="", fmt="%.10g")
-    save_model(believed, d / "model.json")
-    (d / "truth.json").write_text(json.dumps({"effects": truth, "setup": {
-        k: (v if not isinstance(v, float) or math.isfinite(v) else None)
-        for k, v in {**cond, "seed": seed}.items()}}, indent=1))
+    save_case(out / name, rec, hold, believed, truth, {**cond, "seed": seed}, fmt="%.10g")
 
 
 def combination(rng: np.random.Generator, size: int) -> list[str]:
