@@ -465,6 +465,8 @@ def test_lag_attenuation_is_the_lags_not_a_resonance():
     assert [f.effect for f in dg.findings] == ["current_lag"]
     assert dg.findings[0].parameters["bandwidth"] == pytest.approx(64.0, rel=0.15)
     assert dg.unexplained is None
+    # the base refit's floor held the lag's mismatch; the summary gives both floors
+    assert re.search(r"Noise floor \S+ N rms before the findings, \S+ N after", dg.summary())
 
 
 def test_two_effects_that_spoil_each_others_blocks_are_found_together():

@@ -169,8 +169,14 @@ class Diagnosis:
         """A plain-text report for a control engineer."""
         lines: list[str] = [self.verdict] if self.verdict else []
         fb, fa = self.fit["before"], self.fit["after"]
+        after = self.noise.get("rms_after")
+        # the floor is read on the base refit's residual; findings that spread over the
+        # band (a lag's) can lower it a great deal, and then both are said
+        floor = (f"Noise floor {self.noise['rms']:.3g} N rms before the findings, "
+                 f"{after:.3g} N after" if after is not None and after < 0.5 * self.noise["rms"]
+                 else f"Noise floor {self.noise['rms']:.3g} N rms")
         lines.append(
-            f"Noise floor {self.noise['rms']:.3g} N rms (n_eff {self.noise['n_eff']:.0f}). "
+            f"{floor} (n_eff {self.noise['n_eff']:.0f}). "
             f"Force residual {fb['rms_force']:.3g} N -> {fa['rms_force']:.3g} N "
             f"(nrmse {100 * fb['nrmse_force']:.2f} % -> {100 * fa['nrmse_force']:.2f} %)."
         )
