@@ -41,13 +41,9 @@ _SCALE_FLOOR = 1e-12
 
 def design_matrix(name: str, x: Any) -> np.ndarray:
     """``x`` as a 2-D float64 array (rows x columns), or InputError naming it."""
-    try:
-        a = np.asarray(x, dtype=float)
-    except (TypeError, ValueError) as e:
-        raise InputError.at(name, f"must be an array of numbers ({e})") from None
-    if a.ndim != 2:
-        raise InputError.at(name, f"must be a 2-D array (rows x columns), got shape {a.shape}")
-    return a
+    from .reference import _array
+
+    return _array(name, x, ndim=2)
 
 
 def candidate_matrices(extras: Any) -> list[np.ndarray]:

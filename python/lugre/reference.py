@@ -135,14 +135,16 @@ def _parsed(model: ModelLike) -> _Parsed:
     return _parse(_as_model(model)._data)
 
 
-def _array(name: str, a: Any) -> np.ndarray:
-    """``np.asarray(a, float)`` as a 1-D array, or InputError naming the argument."""
+def _array(name: str, a: Any, ndim: int = 1) -> np.ndarray:
+    """``np.asarray(a, float)`` as a 1-D array (2-D: rows x columns, with ``ndim=2``),
+    or InputError naming the argument."""
     try:
         arr = np.asarray(a, dtype=float)
     except (TypeError, ValueError) as e:
         raise InputError.at(name, f"must be an array of numbers ({e})") from None
-    if arr.ndim != 1:
-        raise InputError.at(name, f"must be a 1-D array, got shape {arr.shape}")
+    if arr.ndim != ndim:
+        what = "a 1-D array" if ndim == 1 else f"a {ndim}-D array (rows x columns)"
+        raise InputError.at(name, f"must be {what}, got shape {arr.shape}")
     return arr
 
 

@@ -28,6 +28,8 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
+from ..exceptions import LugreError
+from ..model import _parse_effect
 from .effects import Candidate, Context
 
 __all__ = ["Evaluation", "Scorer", "Term", "forward_select", "told_apart"]
@@ -466,9 +468,6 @@ def compare(cur: Evaluation, new: Evaluation, s2: float) -> dict[str, float]:
 def _unphysical(c: Candidate, h: Any, beta: np.ndarray, ctx: Context) -> str | None:
     """Why the effects a fitted term stands for are no valid model effects, or None
     (the model's own validation: a negative drag coefficient, a dead-band under zero)."""
-    from ..exceptions import LugreError
-    from ..model import _parse_effect
-
     try:
         for e in c.to_effects(h, beta, ctx):
             _parse_effect(e, "effect")
