@@ -509,3 +509,67 @@ def test_verdict_says_when_the_refit_does_not_carry_over():
     worse, better = verdict(dg(12.9)), verdict(dg(0.5))
     assert "does not carry over" in worse and "+1391 %" in worse
     assert "does not carry over" not in better
+
+
+def test_a_gain_the_readings_noise_makes_is_no_finding(monkeypatch):
+    # a clean 17 kg axis, 0.1 um encoder, logged at 5 kHz on point-to-point moves and
+    # diagnosed against the exact model that made it: a damped resonance smooths the
+    # acceleration, twice-differentiated encoder noise included, and so "explains" part
+    # of the noise in every held-out block. Without the SIMEX check it is named; with
+    # it, the gain extrapolated to noise-free readings does not pass
+    from lugre.diagnosis import core
+    from lugre.diagnosis.synth import case
+
+    rec, _hold, _bel, truth = case([], seed=21019, axis_seed=3873, kind="p2p",
+                                   duration=10.0, rate_hz=5000.0, current_noise=0.0235,
+                                   quantum=1e-7, base_error=0.0)
+    dg = diagnose(rec, truth, closed_loop=False)
+    assert dg.findings == []
+    dropped = [g for g in dg.trials if "SIMEX" in g["why"]]
+    assert [g["effect"] for g in dropped] == ["resonance"]
+    assert not dropped[0]["accepted"]
+    monkeypatch.setattr(core, "noise_made", lambda *a, **k: {})
+    assert [f.effect for f in diagnose(rec, truth, closed_loop=False).findings] == [
+        "resonance"]
+
+
+def test_simex_surrogates_match_the_readings_noise():
+    from lugre.diagnosis import residual as R
+    from lugre.diagnosis.simex import surrogates
+    from lugre.diagnosis.synth import case
+
+    rec, _hold, _bel, truth = case([], seed=3, duration=6.0, current_noise=0.02,
+                                   quantum=1e-6, base_error=0.0)
+    sig = R.prepare(rec, truth)
+    sur = surrogates(rec, truth, sig)
+    assert len(sur) == 2
+    for s in sur:  # same band, same rows; the force's added noise at the record's level
+        assert s.cutoff_hz == sig.cutoff_hz and np.array_equal(s.mask, sig.mask)
+    fs = 1.0 / rec.dt
+    added = sur[0].force_raw - sig.force_raw
+    level = R.hf_level(R.hampel(rec.force(truth))[0], fs)
+    assert np.std(added) == pytest.approx(np.sqrt(level * 0.5 * fs), rel=0.05)
+    # antithetic: the pair's additions cancel
+    assert np.allclose(sur[0].force_raw + sur[1].force_raw, 2 * sig.force_raw)
+
+
+def test_a_dead_band_is_the_same_where_the_drive_brakes():
+    # a 27 % friction bump over a fifth of the stroke of an 88 kg axis on constant-speed
+    # feeds had been named a dead-band ("confined but overwhelming"): refitted where
+    # the drive brakes the axis, that dead-band read 2.0 times its band against 0.56
+    # overall. A dead-band is one size wherever the current is over it (the public
+    # dead-band reads 1.05 braking and 1.03 overall and stays named: datasets tests)
+    from lugre.diagnosis.synth import case
+
+    c, w = -0.0761, 0.0312
+    xs = np.linspace(c - 3 * w, c + 3 * w, 25)
+    bump = {"effect": "position_friction", "positions": xs.tolist(),
+            "scale": (1.0 + 0.2727 * np.exp(-0.5 * ((xs - c) / w) ** 2)).tolist()}
+    rec, _hold, believed, _ = case([bump], seed=21062, axis_seed=7538, kind="feeds",
+                                   duration=30.0, rate_hz=2000.0, current_noise=0.0186,
+                                   quantum=1e-7, base_error=0.0082)
+    dg = diagnose(rec, believed, closed_loop=False)
+    assert "deadband" not in [f.effect for f in dg.findings]
+    refused = [g for g in dg.trials
+               if g["effect"] == "deadband" and "no one dead-band" in g["why"]]
+    assert refused and not refused[0]["accepted"]

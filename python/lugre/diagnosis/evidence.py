@@ -343,6 +343,39 @@ def mass_both_ways(scorer: Scorer, terms: list[Term], k: int, ev: Any,
     return out
 
 
+def deadband_braking(scorer: Scorer, terms: list[Term], k: int, ev: Any,
+                     ctx: Any) -> dict[str, Any] | None:
+    """Is the dead-band term ``terms[k]`` a dead-band, the same where the drive brakes?
+
+    A dead-band takes force away along the current: wherever the current is over the
+    band, the logged force is ``b`` more than what acts, in the current's direction.
+    More friction than the model holds also needs more force, but along the motion.
+    The two agree while the drive pushes the axis along (force and velocity of one
+    sign, most of a record) and part while it brakes: there a dead-band still takes
+    force along the current, against the motion. The term is refitted, jointly with
+    the base and the other terms, on the samples where the drive brakes the moving axis
+    (``F*v < 0``); when they determine it (standard error under a quarter of the full
+    fit's) and it differs from the full fit by more than four standard errors and by
+    more than half, no one dead-band explains both: the term stands for something else
+    (a friction bump on part of the stroke read 0.56 of its band overall and 2.0 +- 0.13
+    braking; dead-bands of 2-150 mA on the generator read within 0.35 and 5 standard
+    errors). Returns the figures, or None when the record cannot tell.
+    """
+    sig = ctx.sig
+    m = scorer.mask
+    vmax = float(np.max(np.abs(sig.vf[m])))
+    brake = m & (sig.fm_f * sig.vf < 0) & (np.abs(sig.vf) > 0.02 * vmax)
+    full = float(ev.beta[_start(scorer, terms, k)])
+    # (braking is rare where friction stops the axis: the standard error decides)
+    fit = _refit_on(scorer, terms, k, brake) if full > 0 and brake.sum() >= 20 else None
+    if fit is None:
+        return None
+    b, se = fit
+    return {"coefficient": full, "braking": b, "braking_se": se,
+            "not_deadband": bool(se < 0.25 * full and abs(b - full) > 4.0 * se
+                                 and abs(b - full) > 0.5 * full)}
+
+
 def mass_alternative(delta: float, mass: float, ctx: Any,
                      mask: np.ndarray) -> dict[str, Any] | None:
     """A named mass the record cannot tell from a friction growing with the drive force.

@@ -445,9 +445,24 @@ def compare(cur: Evaluation, new: Evaluation, s2: float) -> dict[str, float]:
         ``positive`` (blocks with a gain), ``blocks``, ``ratio`` (sum of positive over sum of
         negative block gains).
     """
+    out = block_evidence(block_gains(cur, new, s2))
+    out["gain"] = float(cur.score - new.score)
+    fit_gain = float((cur.sse_b.sum() - new.sse_b.sum()) / s2)
+    prior_gain = float(cur.prior - new.prior)
+    return {**out, "fit_gain": fit_gain, "prior_gain": prior_gain,
+            "p_prior": float(stats.chi2.sf(max(prior_gain, 0.0), 1))}
+
+
+def block_gains(cur: Evaluation, new: Evaluation, s2: float) -> np.ndarray:
+    """Per-block gains of ``new`` over ``cur`` as :func:`compare` reads them."""
     K = cur.sse_b.size
-    d = (cur.sse_b - new.sse_b) / s2 + (cur.prior - new.prior) / K
-    gain = float(cur.score - new.score)
+    return (cur.sse_b - new.sse_b) / s2 + (cur.prior - new.prior) / K
+
+
+def block_evidence(d: np.ndarray) -> dict[str, Any]:
+    """:func:`compare`'s evidence from per-block gains ``d``: ``gain`` (their sum),
+    ``t`` and ``p``, ``positive``, ``blocks``, ``ratio``."""
+    K = d.size
     sd = float(np.std(d, ddof=1))
     if sd <= 0:
         t = float("inf") if d.mean() > 0 else 0.0
@@ -457,12 +472,8 @@ def compare(cur: Evaluation, new: Evaluation, s2: float) -> dict[str, float]:
         p = float(stats.t.sf(t, K - 1))
     pos = float(d[d > 0].sum())
     neg = float(-d[d < 0].sum())
-    fit_gain = float((cur.sse_b.sum() - new.sse_b.sum()) / s2)
-    prior_gain = float(cur.prior - new.prior)
-    return {"gain": gain, "t": t, "p": p, "positive": int(np.sum(d > 0)), "blocks": int(d.size),
-            "ratio": pos / neg if neg > 0 else float("inf"), "fit_gain": fit_gain,
-            "prior_gain": prior_gain,
-            "p_prior": float(stats.chi2.sf(max(prior_gain, 0.0), 1))}
+    return {"gain": float(d.sum()), "t": t, "p": p, "positive": int(np.sum(d > 0)),
+            "blocks": int(d.size), "ratio": pos / neg if neg > 0 else float("inf")}
 
 
 def _unphysical(c: Candidate, h: Any, beta: np.ndarray, ctx: Context) -> str | None:
