@@ -528,6 +528,7 @@ def test_a_gain_the_readings_noise_makes_is_no_finding(monkeypatch):
     dropped = [g for g in dg.trials if "SIMEX" in g["why"]]
     assert [g["effect"] for g in dropped] == ["resonance"]
     assert not dropped[0]["accepted"]
+    assert "A resonance passed the held-out test but is not named" in dg.summary()
     monkeypatch.setattr(core, "noise_made", lambda *a, **k: {})
     assert [f.effect for f in diagnose(rec, truth, closed_loop=False).findings] == [
         "resonance"]

@@ -333,3 +333,14 @@ def test_bad_options_are_one_line_usage_errors(case, tmp_path, extra, option):
     line = one_line_error(r)
     assert r.returncode == 2 and option in line, line
     assert not (tmp_path / "m.json").exists()
+
+
+def test_diagnose_band_from_the_command_line(case, tmp_path):
+    d, _, _ = case
+    r = run("diagnose", d / "rec.csv", "--model", d / "model.json", "--json",
+            tmp_path / "r.json", "--cutoff-hz", "20", "-q")
+    assert r.returncode == 0, r.stderr
+    assert json.loads((tmp_path / "r.json").read_text())["noise"]["cutoff_hz"] == 20.0
+    r = run("diagnose", d / "rec.csv", "--model", d / "model.json", "--json",
+            tmp_path / "r2.json", "--cutoff-hz", "-5")
+    assert r.returncode == 2 and "--cutoff-hz" in one_line_error(r)

@@ -303,7 +303,8 @@ def _cmd_diagnose(args: argparse.Namespace) -> int:
     rec = _read(args, args.recording)
     hold = _read(args, args.holdout, "--holdout") if args.holdout else None
     with pr.step("diagnosing (candidate effects, joint refits, held-out checks)"):
-        d = diagnose(rec, model, holdout=hold, screw_lead=args.screw_lead)
+        d = diagnose(rec, model, holdout=hold, screw_lead=args.screw_lead,
+                     cutoff_hz=args.cutoff_hz)
     print(d.summary())
     report = d.to_dict()
     page = None
@@ -587,6 +588,9 @@ def build_parser() -> argparse.ArgumentParser:
                     help="ball-screw lead [m] (one revolution): its pitch and harmonics are "
                          "always tried for a position-periodic force (default: the model's "
                          "axis.screw_lead)")
+    dg.add_argument("--cutoff-hz", type=_POSITIVE, metavar="HZ",
+                    help="band of the force residual [Hz] (default: fs/25, lowered to "
+                         "where the position reading's noise would dominate)")
     recording_options(dg)
     dg.set_defaults(func=_cmd_diagnose)
 

@@ -595,12 +595,17 @@ def diagnose(
     # holds, in every block alike. Each finding's gain is read again with noise like the
     # record's added (SIMEX) and extrapolated back to noise-free readings: a clean 17 kg
     # axis logged at 5 kHz with a 0.1 um encoder had been given a damped 76 Hz
-    # resonance (gain 700, of which the noise made 990)
+    # resonance (gain 1376 in noise units, of which noise like its own made about 1180)
     named_k = [k for k, t in enumerate(terms) if not t.minor]
+    noise_notes: list[str] = []
     if named_k:
         noisy = noise_made(sig, surrogate_signals(), model, (aug, terms, betas, ctx), named_k,
                            scorer.used_blocks, s2, min_gain, alpha)
         if noisy:
+            noise_notes = [
+                f"A {terms[k].effect.replace('_', ' ')} passed the held-out test but is not "
+                f"named: {why}. A finer position reading or a lower band (--cutoff-hz) would "
+                "show whether physics is left under it." for k, why in noisy.items()]
             aug, base, betas, ctx, terms, alternatives = drop_terms(
                 noisy, terms, betas, base, alternatives)
 
@@ -718,7 +723,7 @@ def diagnose(
     findings = [findings[j] for j in order]
 
     base_rep = V.base_report(model, base, names, presliding)
-    notes = V.base_notes(base_rep, findings)
+    notes = V.base_notes(base_rep, findings) + noise_notes
     fit: dict[str, Any] = {"before": _metrics(r0, sig.fm_f, sig.mask),
                            "after": _metrics(r1, sig.fm_f, sig.mask),
                            "holdout_before": {}, "holdout_after": {}}
@@ -767,7 +772,8 @@ def diagnose(
             "model_before": sig.fm_f - r0, "model_after": sig.fm_f - r1,
             "effects": data_effects}
     dg = Diagnosis(findings=findings, fit=fit, model=model, augmented=aug, base=base_rep,
-                   noise={**noise, "rms_before_refit": R.noise_floor(r0, sig)["rms"],
+                   noise={**noise, "cutoff_hz": float(sig.cutoff_hz),
+                          "rms_before_refit": R.noise_floor(r0, sig)["rms"],
                           "rms_after": noise_after["rms"],
                           "expected_rms": expected["rms"],
                           "expected_current": expected["current"],
