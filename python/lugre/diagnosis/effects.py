@@ -81,6 +81,10 @@ class Candidate:
     supersedes: tuple[str, ...] = ()
     #: signature in words, for the evidence
     signature: str = ""
+    #: its column low-passes a reading (the acceleration, noise and all), so that it
+    #: also takes up part of the noise the residual holds: checked by SIMEX
+    #: (:mod:`lugre.diagnosis.simex`)
+    smooths_readings: bool = False
 
     def choose(self, r: np.ndarray, ctx: Context) -> Any:
         """Pick the nonlinear parameter against the current residual ``r`` (filtered)."""
@@ -562,6 +566,7 @@ class Resonance(_Secant):
     effect = "resonance"
     signature = ("a compliant coupling: the load the encoder does not see swings against "
                  "the motor at the coupling's natural frequency")
+    smooths_readings = True
 
     #: damping ratios and load fractions of the search
     ZETAS = (0.03, 0.1, 0.3)

@@ -9,7 +9,8 @@ noise that the residual holds: the errors-in-variables gain. It is the same in e
 held-out block, so the block test cannot tell it from physics; on a clean 17 kg axis
 logged at 5 kHz with a 0.1 um encoder it named a damped 76 Hz resonance.
 
-SIMEX (Cook and Stefanski, 1994) measures it: noise like the record's own is added to
+SIMEX (Cook and Stefanski, 1994) measures it, for the terms whose column smooths a
+reading (``Candidate.smooths_readings``): noise like the record's own is added to
 the readings and the gain read again. Physics keeps its gain; a gain made by the noise
 grows by what the added noise makes, and is extrapolated back to readings without
 noise: ``g0 - ((g(+e) + g(-e))/2 - g0)``. The surrogate pair ``+e, -e`` (antithetic)
