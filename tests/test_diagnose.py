@@ -593,3 +593,20 @@ def test_simex_leaves_terms_that_do_not_smooth_a_reading():
                                    quantum=5e-6, base_error=0.0174)
     dg = diagnose(rec, believed, closed_loop=False)
     assert sorted(f.effect for f in dg.findings) == ["position_friction", "spring"]
+
+
+def test_a_model_that_is_not_passive_is_warned_of_once_per_direction():
+    # the search and the refits build hundreds of trial models from the one given; the
+    # passivity warning is the given model's, once, not one per trial model
+    import warnings
+
+    from lugre.exceptions import PassivityWarning
+
+    rec, believed, _ = concealed("cogging", duration=5.0)
+    d = believed.to_dict()
+    d["friction"]["sigma1"] = 50.0 * max(believed.passivity_bound())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        diagnose(rec, d, closed_loop=False)
+    told = [str(w.message) for w in caught if w.category is PassivityWarning]
+    assert len(told) == 2 and "positive set" in told[0] and "negative set" in told[1]

@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from typing import Any
 
 import numpy as np
 
-from ..exceptions import InputError
+from ..exceptions import InputError, PassivityWarning
 from ..io import Recording
 from ..model import Model, _as_model
 from . import base as B
@@ -271,6 +272,40 @@ def diagnose(
         Too short, no motion, motion in one direction only, gaps in the sampling.
     """
     t_start = time.perf_counter()
+    model = _as_model(model)  # (warns once if the model given is not passive)
+    with warnings.catch_warnings():  # the trial models of the search and the refits
+        warnings.simplefilter("ignore", PassivityWarning)
+        dg = _diagnose(recording, model, holdout=holdout, cutoff_hz=cutoff_hz, blocks=blocks,
+                       alpha=alpha, min_gain=min_gain, closed_loop=closed_loop,
+                       candidates=candidates, screw_lead=screw_lead, free_mass=free_mass,
+                       tolerance=tolerance, backend=backend)
+    if model.is_passive and not dg.augmented.is_passive:
+        warnings.warn(
+            "the augmented model's sigma1 exceeds the passivity bound 4*sigma2*fc/(fs - fc) "
+            "of its friction (Barabanov & Ortega 2000): the refit moved sigma1 or the "
+            "levels that far; check the base moves in the report before using it",
+            PassivityWarning, stacklevel=2)
+    dg.timing = time.perf_counter() - t_start
+    return dg
+
+
+def _diagnose(
+    recording: Any,
+    model: Any,
+    *,
+    holdout: Any = None,
+    cutoff_hz: float | None = None,
+    blocks: int = 10,
+    alpha: float = 1e-3,
+    min_gain: float = 10.0,
+    closed_loop: bool = True,
+    candidates: list[str] | None = None,
+    screw_lead: float | None = None,
+    free_mass: bool = False,
+    tolerance: float = 1.0,
+    backend: str = "core",
+) -> Diagnosis:
+    """:func:`diagnose` without its warnings' filter."""
     rec = as_recording(recording)
     model = _as_model(model)
     # 1. prepare: checks, filtered signals, the residual of the model as given
@@ -745,7 +780,6 @@ def diagnose(
     dg.minor = minor
     dg.base_moves = V.base_moves(base_rep)
     dg.verdict = V.verdict(dg)
-    dg.timing = time.perf_counter() - t_start
     return dg
 
 
