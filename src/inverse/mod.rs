@@ -26,6 +26,7 @@ pub use spectrum::{position_sums, PositionSums, MAX_FREQUENCIES, RESEED};
 
 use crate::error::{check_finite, check_len, Error, Result};
 use crate::friction::{LugreParams, StaticSet};
+use crate::servo::coupling::coupling_forces;
 use crate::servo::fast::{Fast, Power, Shape, Square};
 use crate::servo::{coupling_force, CouplingOptions, Effect, Model};
 
@@ -354,35 +355,62 @@ impl Record {
     /// along the drive motion with its friction, the friction scales and the effect
     /// forces on it.
     pub fn coupling_force(&self, model: &Model) -> Result<Vec<f64>> {
-        let scale = self.friction_scale(model);
-        let extra = self.effect_force(model);
-        let opts = CouplingOptions {
-            scale: scale.as_deref(),
-            extra: Some(&extra),
+        let (scale, extra) = self.load_forces(model);
+        let opts = self.coupling_options(scale.as_deref(), &extra);
+        coupling_force(model, &self.x_drive, &self.v, self.dt, &opts)
+    }
+
+    /// The friction scale and the effect forces acting on the load of a `resonance`.
+    fn load_forces(&self, model: &Model) -> (Option<Vec<f64>>, Vec<f64>) {
+        (self.friction_scale(model), self.effect_force(model))
+    }
+
+    /// The options of the load simulation of [`Record::coupling_force`].
+    fn coupling_options<'a>(
+        &self,
+        scale: Option<&'a [f64]>,
+        extra: &'a [f64],
+    ) -> CouplingOptions<'a> {
+        CouplingOptions {
+            scale,
+            extra: Some(extra),
             z0: 0.0,
             substeps: COUPLING_SUBSTEPS,
-        };
-        coupling_force(model, &self.x_drive, &self.v, self.dt, &opts)
+        }
+    }
+
+    /// The `load_fraction` of the model's `resonance`, if it has one.
+    fn load_fraction(model: &Model) -> Option<f64> {
+        model.effects.iter().find_map(|e| match e {
+            Effect::Resonance { load_fraction, .. } => Some(*load_fraction),
+            _ => None,
+        })
     }
 
     /// Filtered force the model needs besides the motor: `m*a + F_friction + F_effects`
     /// (with a `resonance`: `(1 - r)*m*a + F_coupling`).
     pub fn model_force(&self, model: &Model) -> Result<Vec<f64>> {
+        let coupling = match Self::load_fraction(model) {
+            None => None,
+            Some(_) => Some(self.coupling_force(model)?),
+        };
+        Ok(self.model_force_with(model, coupling))
+    }
+
+    /// [`Record::model_force`] with the unfiltered coupling force of a model with a
+    /// `resonance` given.
+    fn model_force_with(&self, model: &Model, coupling: Option<Vec<f64>>) -> Vec<f64> {
         let m = model.total_mass();
-        let res = model.effects.iter().find_map(|e| match e {
-            Effect::Resonance { load_fraction, .. } => Some(*load_fraction),
-            _ => None,
-        });
-        let (ma, f) = match res {
-            None => {
+        let (ma, f) = match (Self::load_fraction(model), coupling) {
+            (Some(r), Some(fc)) => ((1.0 - r) * m, self.filt(&fc)),
+            _ => {
                 let mut f = self.base_friction(model);
                 let e = self.effect_force(model);
                 f.iter_mut().zip(&e).for_each(|(a, b)| *a += b);
                 (m, self.filt(&f))
             }
-            Some(r) => ((1.0 - r) * m, self.filt(&self.coupling_force(model)?)),
         };
-        Ok(self.a.iter().zip(&f).map(|(a, f)| ma * a + f).collect())
+        self.a.iter().zip(&f).map(|(a, f)| ma * a + f).collect()
     }
 
     /// Filtered motor force after the model's `delay`, `deadband` and `current_lag`
@@ -429,10 +457,41 @@ impl Record {
     }
 
     /// [`Record::residual`] of several models, in parallel (rayon); the first error
-    /// in the order of `models` when any fails.
+    /// in the order of `models` when any fails. The load simulations of the models
+    /// with a `resonance` run interleaved, several in one loop
+    /// ([`crate::servo::coupling::LANES`]); the results are those of one at a time.
     pub fn residuals(&self, models: &[Model]) -> Result<Vec<Vec<f64>>> {
         use rayon::prelude::*;
-        models.par_iter().map(|m| self.residual(m)).collect()
+        let coupled: Vec<usize> = (0..models.len())
+            .filter(|&j| Self::load_fraction(&models[j]).is_some())
+            .collect();
+        let loads: Vec<(Option<Vec<f64>>, Vec<f64>)> = coupled
+            .par_iter()
+            .map(|&j| self.load_forces(&models[j]))
+            .collect();
+        let jobs: Vec<(&Model, CouplingOptions)> = coupled
+            .iter()
+            .zip(&loads)
+            .map(|(&j, (s, e))| (&models[j], self.coupling_options(s.as_deref(), e)))
+            .collect();
+        let mut forces: Vec<Option<Result<Vec<f64>>>> = (0..models.len()).map(|_| None).collect();
+        for (&j, f) in coupled
+            .iter()
+            .zip(coupling_forces(&jobs, &self.x_drive, &self.v, self.dt))
+        {
+            forces[j] = Some(f);
+        }
+        models
+            .par_iter()
+            .zip(forces.into_par_iter())
+            .map(|(m, f)| {
+                let coupling = f.transpose()?;
+                let mut r = self.motor_force(m);
+                let need = self.model_force_with(m, coupling);
+                r.iter_mut().zip(&need).for_each(|(a, b)| *a -= b);
+                Ok(r)
+            })
+            .collect()
     }
 
     /// The LuGre force of [`Record::base_friction`] and its filtered derivatives with
