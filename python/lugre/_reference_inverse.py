@@ -92,6 +92,12 @@ def _midpoints(a: np.ndarray) -> np.ndarray:
     return h
 
 
+#: Samples of a pass between two flushes of the sections' states, and the magnitude under
+#: which a state is set to zero (src/inverse/filter.rs, FLUSH_EVERY and FLUSH).
+_FLUSH_EVERY = 32
+_FLUSH = 1e-270
+
+
 class _Lowpass:
     """Second-order sections forward and backward, odd extension (SciPy's
     ``sosfiltfilt(padtype="odd")``)."""
@@ -136,6 +142,9 @@ class _Lowpass:
                 s[1] = c[2] * x - c[5] * out
                 x = out
             y[k] = x
+            if (k + 1) % _FLUSH_EVERY == 0:
+                for s in st:  # states decaying towards the subnormal numbers: zero
+                    s[:] = [0.0 if abs(v) < _FLUSH else v for v in s]
 
     def filtfilt(self, y: np.ndarray) -> np.ndarray:
         n = y.size
