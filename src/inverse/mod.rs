@@ -84,17 +84,21 @@ impl BaseParam {
         }
     }
 
-    /// `(d g/d theta, d sigma2/d theta)` of the set that acts at `v` (unscaled).
+    /// `(d g/d theta, d sigma2/d theta)` of the set that acts at the speed where
+    /// `stribeck_e` gives `(e, pw)` (unscaled).
     #[inline(always)]
-    fn dg(self, set: &StaticSet<f64>, positive: bool, v: f64, exponent: f64) -> (f64, f64) {
+    fn dg(
+        self,
+        set: &StaticSet<f64>,
+        positive: bool,
+        (e, pw): (f64, f64),
+        exponent: f64,
+    ) -> (f64, f64) {
         let own = |p: bool| p == positive;
         match self {
-            BaseParam::Fc(p) if own(p) => (1.0 - stribeck_e(set, v, exponent).0, 0.0),
-            BaseParam::Fs(p) if own(p) => (stribeck_e(set, v, exponent).0, 0.0),
-            BaseParam::Vs(p) if own(p) => {
-                let (e, pw) = stribeck_e(set, v, exponent);
-                ((set.fs - set.fc) * e * exponent * pw / set.vs, 0.0)
-            }
+            BaseParam::Fc(p) if own(p) => (1.0 - e, 0.0),
+            BaseParam::Fs(p) if own(p) => (e, 0.0),
+            BaseParam::Vs(p) if own(p) => ((set.fs - set.fc) * e * exponent * pw / set.vs, 0.0),
             BaseParam::Sigma2(p) if own(p) => (0.0, 1.0),
             _ => (0.0, 0.0),
         }
@@ -520,8 +524,10 @@ impl Record {
             let g = sc * g_of(p, v, exponent);
             let w = v - s0 * v.abs() * z / g;
             force[k] = s0 * z + s1 * w + set.sigma2 * v;
+            // (one exponential for every parameter of the set; unused without fc, fs, vs)
+            let e = stribeck_e(set, v, ex);
             for (j, par) in params.iter().enumerate() {
-                let (dg0, ds2) = par.dg(set, pos, v, ex);
+                let (dg0, ds2) = par.dg(set, pos, e, ex);
                 let dg = sc * dg0;
                 let ds0 = if *par == BaseParam::Sigma0 { 1.0 } else { 0.0 };
                 let ds1 = if *par == BaseParam::Sigma1 { 1.0 } else { 0.0 };
@@ -543,8 +549,9 @@ impl Record {
             let sign = if u > 0.0 { 1.0 } else { -1.0 };
             let zss = sign * gh / s0;
             let e = (-(s0 * u.abs() * self.dt / gh)).exp();
+            let eu = stribeck_e(uset, u, ex);
             for (j, par) in params.iter().enumerate() {
-                let dgh = su * par.dg(uset, upos, u, ex).0;
+                let dgh = su * par.dg(uset, upos, eu, ex).0;
                 let ds0 = if *par == BaseParam::Sigma0 { 1.0 } else { 0.0 };
                 let dzss = sign * (dgh / s0 - gh * ds0 / (s0 * s0));
                 let da = u.abs() * self.dt * (ds0 / gh - s0 * dgh / (gh * gh));
