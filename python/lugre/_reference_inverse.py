@@ -214,6 +214,22 @@ class InverseRecord:
                                 "give arrays of the same length")
         return self._filter.filtfilt(ys)
 
+    def filt_columns(self, y: Any) -> np.ndarray:
+        """The parallel low-pass of each column of an ``(n, m)`` matrix."""
+        try:
+            arr = np.array(y, dtype=float)
+        except (TypeError, ValueError) as e:
+            raise InputError.at("y", f"must be an array of numbers ({e})") from None
+        if arr.ndim != 2:
+            raise InputError.at("y", "must be a 2-D float64 array")
+        if arr.shape[0] != len(self):
+            raise InputError.at("y", f"has {arr.shape[0]} rows but the record has "
+                                f"{len(self)} samples: give one row per sample")
+        out = np.empty_like(arr)
+        for j in range(arr.shape[1]):
+            out[:, j] = self._filter.filtfilt(arr[:, j])
+        return out
+
     def friction_scale(self, model: ModelLike) -> np.ndarray | None:
         """Product of the ``position_friction`` and ``drift`` scales, or None."""
         m = _as_model(model)

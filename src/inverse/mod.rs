@@ -21,7 +21,7 @@
 mod filter;
 mod spectrum;
 
-pub use filter::Lowpass;
+pub use filter::{Lowpass, LANES};
 pub use spectrum::{position_sums, PositionSums, MAX_FREQUENCIES, RESEED};
 
 use crate::error::{check_finite, check_len, Error, Result};
@@ -255,6 +255,18 @@ impl Record {
         self.filter.filtfilt(y)
     }
 
+    /// [`Record::filt`] of several signals of the record's length, side by side
+    /// ([`Lowpass::filtfilt_many`]) and in parallel (rayon).
+    pub fn filt_many(&self, ys: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        use rayon::prelude::*;
+        ys.par_chunks(LANES)
+            .flat_map_iter(|chunk| {
+                let refs: Vec<&[f64]> = chunk.iter().map(Vec::as_slice).collect();
+                self.filter.filtfilt_many(&refs)
+            })
+            .collect()
+    }
+
     /// Product of the `position_friction` and `drift` scales, in the order of the
     /// effects, or `None` without them.
     pub fn friction_scale(&self, model: &Model) -> Option<Vec<f64>> {
@@ -404,17 +416,29 @@ impl Record {
     /// [`Record::model_force`] with the unfiltered coupling force of a model with a
     /// `resonance` given.
     fn model_force_with(&self, model: &Model, coupling: Option<Vec<f64>>) -> Vec<f64> {
+        let (ma, f) = self.model_force_raw(model, coupling);
+        self.add_inertia(ma, &self.filt(&f))
+    }
+
+    /// The mass that the measured acceleration moves and the unfiltered force the model
+    /// needs besides it: `(m, F_friction + F_effects)`, with a `resonance` (its
+    /// coupling force given) `((1 - r)*m, F_coupling)`.
+    fn model_force_raw(&self, model: &Model, coupling: Option<Vec<f64>>) -> (f64, Vec<f64>) {
         let m = model.total_mass();
-        let (ma, f) = match (Self::load_fraction(model), coupling) {
-            (Some(r), Some(fc)) => ((1.0 - r) * m, self.filt(&fc)),
+        match (Self::load_fraction(model), coupling) {
+            (Some(r), Some(fc)) => ((1.0 - r) * m, fc),
             _ => {
                 let mut f = self.base_friction(model);
                 let e = self.effect_force(model);
                 f.iter_mut().zip(&e).for_each(|(a, b)| *a += b);
-                (m, self.filt(&f))
+                (m, f)
             }
-        };
-        self.a.iter().zip(&f).map(|(a, f)| ma * a + f).collect()
+        }
+    }
+
+    /// `ma*a + f`.
+    fn add_inertia(&self, ma: f64, f: &[f64]) -> Vec<f64> {
+        self.a.iter().zip(f).map(|(a, f)| ma * a + f).collect()
     }
 
     /// Filtered motor force after the model's `delay`, `deadband` and `current_lag`
@@ -463,12 +487,15 @@ impl Record {
     /// [`Record::residual`] of several models, in parallel (rayon); the first error
     /// in the order of `models` when any fails. The load simulations of the models
     /// with a `resonance` run interleaved, several in one loop
-    /// ([`crate::servo::coupling::LANES`]); the results are those of one at a time.
+    /// ([`crate::servo::coupling::LANES`]), and so do their low-passes
+    /// ([`Lowpass::filtfilt_many`]); the results are those of one at a time.
     pub fn residuals(&self, models: &[Model]) -> Result<Vec<Vec<f64>>> {
         use rayon::prelude::*;
-        let coupled: Vec<usize> = (0..models.len())
-            .filter(|&j| Self::load_fraction(&models[j]).is_some())
-            .collect();
+        let (coupled, plain): (Vec<usize>, Vec<usize>) =
+            (0..models.len()).partition(|&j| Self::load_fraction(&models[j]).is_some());
+        let mut out: Vec<Option<Result<Vec<f64>>>> = (0..models.len()).map(|_| None).collect();
+        // the models with a resonance: their load simulations side by side, then (in
+        // the cache) the low-passes of those forces side by side
         let loads: Vec<(Option<Vec<f64>>, Vec<f64>)> = coupled
             .par_iter()
             .map(|&j| self.load_forces(&models[j]))
@@ -478,22 +505,61 @@ impl Record {
             .zip(&loads)
             .map(|(&j, (s, e))| (&models[j], self.coupling_options(s.as_deref(), e)))
             .collect();
-        let mut forces: Vec<Option<Result<Vec<f64>>>> = (0..models.len()).map(|_| None).collect();
-        for (&j, f) in coupled
-            .iter()
-            .zip(coupling_forces(&jobs, &self.x_drive, &self.v, self.dt))
-        {
-            forces[j] = Some(f);
+        let done = coupling_forces(&jobs, &self.x_drive, &self.v, self.dt, |idx, forces| {
+            let ms: Vec<&Model> = idx.iter().map(|&i| &models[coupled[i]]).collect();
+            let mut raw = Vec::with_capacity(idx.len());
+            let mut errors = Vec::new();
+            for (k, f) in forces.into_iter().enumerate() {
+                match f {
+                    Ok(fc) => raw.push((k, self.model_force_raw(ms[k], Some(fc)))),
+                    Err(e) => errors.push((k, e)),
+                }
+            }
+            let mut res: Vec<Option<Result<Vec<f64>>>> = (0..idx.len()).map(|_| None).collect();
+            for (k, r) in self.finish(&ms, raw) {
+                res[k] = Some(Ok(r));
+            }
+            for (k, e) in errors {
+                res[k] = Some(Err(e));
+            }
+            res.into_iter().map(|r| r.expect("one result")).collect()
+        });
+        for (&j, r) in coupled.iter().zip(done) {
+            out[j] = Some(r);
         }
-        models
-            .par_iter()
-            .zip(forces.into_par_iter())
-            .map(|(m, f)| {
-                let coupling = f.transpose()?;
-                let mut r = self.motor_force(m);
-                let need = self.model_force_with(m, coupling);
+        // the others: friction and effect forces, low-passed side by side
+        let done: Vec<(usize, Vec<f64>)> = plain
+            .par_chunks(LANES)
+            .flat_map_iter(|chunk| {
+                let ms: Vec<&Model> = chunk.iter().map(|&j| &models[j]).collect();
+                let raw = (0..chunk.len())
+                    .map(|k| (k, self.model_force_raw(ms[k], None)))
+                    .collect();
+                self.finish(&ms, raw)
+                    .into_iter()
+                    .map(|(k, r)| (chunk[k], r))
+            })
+            .collect();
+        for (j, r) in done {
+            out[j] = Some(Ok(r));
+        }
+        out.into_iter()
+            .map(|r| r.expect("every model has a residual"))
+            .collect()
+    }
+
+    /// The residuals of models (`ms[k]`) from their unfiltered model forces
+    /// ([`Record::model_force_raw`], by index `k`), the low-passes side by side.
+    fn finish(&self, ms: &[&Model], raw: Vec<(usize, (f64, Vec<f64>))>) -> Vec<(usize, Vec<f64>)> {
+        let ys: Vec<&[f64]> = raw.iter().map(|(_, (_, f))| f.as_slice()).collect();
+        let filtered = self.filter.filtfilt_many(&ys);
+        raw.iter()
+            .zip(&filtered)
+            .map(|((k, (ma, _)), f)| {
+                let mut r = self.motor_force(ms[*k]);
+                let need = self.add_inertia(*ma, f);
                 r.iter_mut().zip(&need).for_each(|(a, b)| *a -= b);
-                Ok(r)
+                (*k, r)
             })
             .collect()
     }
@@ -560,7 +626,7 @@ impl Record {
             z = p.advance_z(z, u, gh, self.dt);
         }
         let nonzero = cols.iter().map(|c| c.iter().any(|&x| x != 0.0)).collect();
-        let columns = cols.iter().map(|c| self.filt(c)).collect();
+        let columns = self.filt_many(&cols);
         Sensitivities {
             force,
             columns,

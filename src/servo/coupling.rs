@@ -241,17 +241,20 @@ pub(crate) const LANES: usize = 4; // (run_lanes has a loop for each width up to
 
 /// The coupling forces of several load simulations along one motor motion, as
 /// [`coupling_force`] of each `(model, options)` (bit for bit), up to [`LANES`] at a
-/// time interleaved in one loop, the groups in parallel (rayon): simulations with the
-/// same number of substeps and the same Stribeck shape share a loop.
+/// time interleaved in one loop, the loops in parallel (rayon): simulations with the
+/// same number of substeps and the same Stribeck shape share a loop. Each loop's
+/// forces go to `then` with the indices of their jobs while they are in the cache;
+/// `then` returns one result per job of the loop (the forces themselves: `|_, f| f`).
 #[cfg(feature = "std")]
-pub(crate) fn coupling_forces(
+pub(crate) fn coupling_forces<T: Send>(
     jobs: &[(&Model, CouplingOptions<'_>)],
     x: &[f64],
     v: &[f64],
     dt: f64,
-) -> Vec<Result<Vec<f64>>> {
+    then: impl Fn(&[usize], Vec<Result<Vec<f64>>>) -> Vec<Result<T>> + Sync,
+) -> Vec<Result<T>> {
     use rayon::prelude::*;
-    let mut out: Vec<Result<Vec<f64>>> = Vec::with_capacity(jobs.len());
+    let mut out: Vec<Option<Result<T>>> = Vec::with_capacity(jobs.len());
     let mut ready: Vec<Ready> = Vec::new();
     for (j, (m, o)) in jobs.iter().enumerate() {
         let checked = Coupling::from_model(m)
@@ -264,9 +267,9 @@ pub(crate) fn coupling_forces(
                     job: j,
                     cp,
                 });
-                out.push(Ok(Vec::new()));
+                out.push(None);
             }
-            Err(e) => out.push(Err(e)),
+            Err(e) => out.push(Some(Err(e))),
         }
     }
     // jobs of one loop side by side (stable: in the order of the jobs), then at most
@@ -280,19 +283,24 @@ pub(crate) fn coupling_forces(
     for group in ready.chunk_by(|a, b| (a.n_sub, a.exponent) == (b.n_sub, b.exponent)) {
         chunks.extend(group.chunks(width));
     }
-    let done: Vec<(usize, Result<Vec<f64>>)> = chunks
+    let done: Vec<(usize, Result<T>)> = chunks
         .par_iter()
         .flat_map_iter(|chunk| {
             let lanes: Vec<(&Coupling, &CouplingOptions)> =
                 chunk.iter().map(|r| (&r.cp, &jobs[r.job].1)).collect();
+            let idx: Vec<usize> = chunk.iter().map(|r| r.job).collect();
             let forces = run_lanes(&lanes, x, v, dt, chunk[0].n_sub);
-            chunk.iter().map(|r| r.job).zip(forces)
+            let results = then(&idx, forces);
+            assert_eq!(results.len(), idx.len(), "one result per job");
+            idx.into_iter().zip(results)
         })
         .collect();
     for (j, f) in done {
-        out[j] = f;
+        out[j] = Some(f);
     }
-    out
+    out.into_iter()
+        .map(|r| r.expect("every job has a result"))
+        .collect()
 }
 
 /// A job of [`coupling_forces`] with checked inputs: its loop (substeps, Stribeck
@@ -628,7 +636,7 @@ mod tests {
         let mut opts: Vec<CouplingOptions> = (0..7).map(|j| [plain, shaped][j % 2]).collect();
         opts.extend([plain, wrong, plain]);
         let jobs: Vec<(&Model, CouplingOptions)> = models.iter().zip(opts).collect();
-        let all = coupling_forces(&jobs, &x, &v, dt);
+        let all = coupling_forces(&jobs, &x, &v, dt, |_, f| f);
         assert_eq!(all.len(), jobs.len());
         let mut errors = 0;
         for ((m, o), got) in jobs.iter().zip(&all) {
