@@ -556,9 +556,11 @@ impl Record {
         raw.iter()
             .zip(&filtered)
             .map(|((k, (ma, _)), f)| {
+                // motor force minus what the model needs, `ma*a + f`
                 let mut r = self.motor_force(ms[*k]);
-                let need = self.add_inertia(*ma, f);
-                r.iter_mut().zip(&need).for_each(|(a, b)| *a -= b);
+                for ((r, a), f) in r.iter_mut().zip(&self.a).zip(f) {
+                    *r -= ma * a + f;
+                }
                 (*k, r)
             })
             .collect()
