@@ -139,6 +139,37 @@ def test_filter_as_scipy(n, order, wn, padlen, seed):
     np.testing.assert_allclose(a, want, rtol=0, atol=1e-11 * max(np.max(np.abs(want)), 1.0))
 
 
+def test_filter_columns_side_by_side_as_one_by_one():
+    """``filt_columns`` filters several columns side by side in the core: each column
+    to the last bit as ``filt`` alone and as the twin, a column that falls to zero
+    (its states flushed, not left among the subnormal numbers) included."""
+    n = 3000
+    rng = np.random.default_rng(5)
+    sos = signal.butter(4, 0.3, output="sos")
+    z = np.zeros(n)
+    hat = np.where(np.abs(np.arange(n) - 60) < 20, 1.0, 0.0)
+    for m in (0, 1, 5, 9):
+        Y = np.column_stack([hat] + [rng.standard_normal(n) for _ in range(m - 1)]
+                            ) if m else np.zeros((n, 0))
+        for cls in (_core.InverseRecord, reference.InverseRecord):
+            k = cls(z, z, z, z, z, z, z, 1e-3, sos, 72)
+            out = k.filt_columns(Y)
+            assert out.shape == (n, m)
+            for j in range(m):
+                np.testing.assert_array_equal(out[:, j], k.filt(np.ascontiguousarray(Y[:, j])))
+            if m:
+                tail = out[1000:, 0]
+                assert np.all((tail == 0) | (np.abs(tail) >= np.finfo(float).tiny))
+                assert np.all(tail[-500:] == 0)
+        a = _core.InverseRecord(z, z, z, z, z, z, z, 1e-3, sos, 72).filt_columns(Y)
+        b = reference.InverseRecord(z, z, z, z, z, z, z, 1e-3, sos, 72).filt_columns(Y)
+        np.testing.assert_array_equal(a, b)
+    for cls in (_core.InverseRecord, reference.InverseRecord):
+        with pytest.raises(InputError) as e:
+            cls(z, z, z, z, z, z, z, 1e-3, sos, 72).filt_columns(np.zeros((n - 1, 2)))
+        assert e.value.name == "y"
+
+
 BAD = {
     "length": ({"x": np.zeros(5)}, InputError, "x"),
     "nan": ({"v": np.array([0.0, np.nan, 0, 0, 0, 0])}, InputError, "v"),

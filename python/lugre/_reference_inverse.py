@@ -92,6 +92,12 @@ def _midpoints(a: np.ndarray) -> np.ndarray:
     return h
 
 
+#: Samples of a pass between two flushes of the sections' states, and the magnitude under
+#: which a state is set to zero (src/inverse/filter.rs, FLUSH_EVERY and FLUSH).
+_FLUSH_EVERY = 32
+_FLUSH = 1e-270
+
+
 class _Lowpass:
     """Second-order sections forward and backward, odd extension (SciPy's
     ``sosfiltfilt(padtype="odd")``)."""
@@ -136,6 +142,9 @@ class _Lowpass:
                 s[1] = c[2] * x - c[5] * out
                 x = out
             y[k] = x
+            if (k + 1) % _FLUSH_EVERY == 0:
+                for s in st:  # states decaying towards the subnormal numbers: zero
+                    s[:] = [0.0 if abs(v) < _FLUSH else v for v in s]
 
     def filtfilt(self, y: np.ndarray) -> np.ndarray:
         n = y.size
@@ -204,6 +213,22 @@ class InverseRecord:
             raise InputError.at("y", f"has {ys.size} samples but the record has {len(self)}: "
                                 "give arrays of the same length")
         return self._filter.filtfilt(ys)
+
+    def filt_columns(self, y: Any) -> np.ndarray:
+        """The parallel low-pass of each column of an ``(n, m)`` matrix."""
+        try:
+            arr = np.array(y, dtype=float)
+        except (TypeError, ValueError) as e:
+            raise InputError.at("y", f"must be an array of numbers ({e})") from None
+        if arr.ndim != 2:
+            raise InputError.at("y", "must be a 2-D float64 array")
+        if arr.shape[0] != len(self):
+            raise InputError.at("y", f"has {arr.shape[0]} rows but the record has "
+                                f"{len(self)} samples: give one row per sample")
+        out = np.empty_like(arr)
+        for j in range(arr.shape[1]):
+            out[:, j] = self._filter.filtfilt(arr[:, j])
+        return out
 
     def friction_scale(self, model: ModelLike) -> np.ndarray | None:
         """Product of the ``position_friction`` and ``drift`` scales, or None."""

@@ -420,6 +420,15 @@ def _parse(v: Mapping[str, Any]) -> _Parsed:
         lim = _positive(lim, "axis.current_limit")
     axis = _Axis(mass, kf, current_loop, lim)
     friction = _parse_friction(_get(v, "friction", ""), "friction")
+    effects = _parse_effects(v, mass)
+    c = v.get("controller")
+    controller = None if c is None else _parse_controller(c, friction)
+    return _Parsed(axis, friction, effects, controller)
+
+
+def _parse_effects(v: Mapping[str, Any], mass: float) -> tuple[_Effect, ...]:
+    """Validate the ``effects`` of a model document whose axis has ``mass`` (the part
+    of :func:`_parse` that depends on them, in its order)."""
     effects: list[_Effect] = []
     ev = v.get("effects")
     if ev is not None:
@@ -443,9 +452,7 @@ def _parse(v: Mapping[str, Any]) -> _Parsed:
         raise ParameterError.invalid(
             "effects.mass.delta", float(dm), "makes the total mass zero or negative"
         )
-    c = v.get("controller")
-    controller = None if c is None else _parse_controller(c, friction)
-    return _Parsed(axis, friction, tuple(effects), controller)
+    return tuple(effects)
 
 
 def _plain(obj: Any, path: str = "") -> Any:
@@ -806,15 +813,24 @@ class Model:
                 d.pop(k, None)
             else:
                 d[k] = _plain(val, k)
+        if set(sections) == {"effects"}:
+            # only the effects change: the axis, friction and controller as parsed (the
+            # grids of the diagnosis build a hundred such models)
+            return Model._checked(d, self._parsed)
         return Model._checked(d)
 
     @classmethod
-    def _checked(cls, plain: dict[str, Any]) -> Model:
-        """A model of a JSON-ready document (validated, not copied again)."""
+    def _checked(cls, plain: dict[str, Any], same: _Parsed | None = None) -> Model:
+        """A model of a JSON-ready document (validated, not copied again); ``same``: the
+        parsed model whose document differs from ``plain`` in its effects only."""
         m = cls.__new__(cls)
         m._core = None
         m._data = plain
-        m._parsed = _parse(plain)
+        if same is None:
+            m._parsed = _parse(plain)
+        else:
+            m._parsed = _Parsed(same.axis, same.friction,
+                                _parse_effects(plain, same.axis.mass), same.controller)
         m._warn_passivity()
         return m
 

@@ -4,10 +4,46 @@
 //! padlen=padlen)` step for step: odd extension of `padlen` samples at both ends, each
 //! section started in the steady state of the first (then last) extended sample
 //! (`sosfilt_zi`), the sections run in direct form II transposed, forward then backward,
-//! and the extension cut off. The coefficients come from the caller (a Butterworth
-//! design, `scipy.signal.butter(..., output="sos")` in the Python package).
+//! and the extension cut off; the one difference: states under [`FLUSH`] are set to
+//! zero every [`FLUSH_EVERY`] samples. The coefficients come from the caller (a
+//! Butterworth design, `scipy.signal.butter(..., output="sos")` in the Python package).
 
 use crate::error::{Error, Result};
+
+/// Signals filtered side by side by [`Lowpass::filtfilt_many`].
+pub const LANES: usize = 4;
+
+/// Samples of a pass between two flushes of the sections' states.
+pub const FLUSH_EVERY: usize = 32;
+
+/// States smaller than this in magnitude are set to zero after every [`FLUSH_EVERY`]
+/// samples of a pass: a signal that falls to zero leaves states decaying through the
+/// subnormal numbers (or cycling among the smallest of them), where each operation
+/// takes a hundred times longer (a `position_friction` hat column, zero over most
+/// of the record, filtered 40 times slower than the motor force).
+pub const FLUSH: f64 = 1e-270;
+
+/// Set the states under [`FLUSH`] in magnitude to zero.
+#[inline(always)]
+fn flush<const W: usize>(states: &mut [[f64; W]]) {
+    for v in states.iter_mut().flatten() {
+        if v.abs() < FLUSH {
+            *v = 0.0;
+        }
+    }
+}
+
+/// One sample through `N` sections (transposed direct form II).
+#[inline(always)]
+fn step_n<const N: usize>(c: &[[f64; 6]; N], st: &mut [[f64; 2]; N], mut x: f64) -> f64 {
+    for j in 0..N {
+        let out = c[j][0] * x + st[j][0];
+        st[j][0] = c[j][1] * x - c[j][4] * out + st[j][1];
+        st[j][1] = c[j][2] * x - c[j][5] * out;
+        x = out;
+    }
+    x
+}
 
 /// A cascade of second-order sections `[b0, b1, b2, 1, a1, a2]` run forward and
 /// backward; no sections is the identity.
@@ -100,20 +136,20 @@ impl Lowpass {
         for (s, z) in st.iter_mut().zip(&self.zi) {
             *s = [z[0] * x0, z[1] * x0];
         }
-        let mut one = |yk: &mut f64| {
-            let mut x = *yk;
-            for j in 0..N {
-                let out = c[j][0] * x + st[j][0];
-                st[j][0] = c[j][1] * x - c[j][4] * out + st[j][1];
-                st[j][1] = c[j][2] * x - c[j][5] * out;
-                x = out;
-            }
-            *yk = x;
-        };
         if backward {
-            y.iter_mut().rev().for_each(&mut one);
+            for block in y.rchunks_mut(FLUSH_EVERY) {
+                for yk in block.iter_mut().rev() {
+                    *yk = step_n(&c, &mut st, *yk);
+                }
+                flush(&mut st);
+            }
         } else {
-            y.iter_mut().for_each(&mut one);
+            for block in y.chunks_mut(FLUSH_EVERY) {
+                for yk in block.iter_mut() {
+                    *yk = step_n(&c, &mut st, *yk);
+                }
+                flush(&mut st);
+            }
         }
     }
 
@@ -124,7 +160,7 @@ impl Lowpass {
         for (s, z) in st.iter_mut().zip(&self.zi) {
             *s = [z[0] * x0, z[1] * x0];
         }
-        let mut one = |yk: &mut f64| {
+        let one = |yk: &mut f64, st: &mut [[f64; 2]]| {
             let mut x = *yk;
             for (c, s) in self.sections.iter().zip(st.iter_mut()) {
                 let out = c[0] * x + s[0];
@@ -135,9 +171,15 @@ impl Lowpass {
             *yk = x;
         };
         if backward {
-            y.iter_mut().rev().for_each(&mut one);
+            for block in y.rchunks_mut(FLUSH_EVERY) {
+                block.iter_mut().rev().for_each(|yk| one(yk, &mut st));
+                flush(&mut st);
+            }
         } else {
-            y.iter_mut().for_each(&mut one);
+            for block in y.chunks_mut(FLUSH_EVERY) {
+                block.iter_mut().for_each(|yk| one(yk, &mut st));
+                flush(&mut st);
+            }
         }
     }
 
@@ -147,6 +189,66 @@ impl Lowpass {
         if self.is_identity() || n == 0 {
             return y.to_vec();
         }
+        let (mut ext, edge) = self.extend(y);
+        // forward, then backward from the last output (SciPy reverses the signal twice)
+        self.run(&mut ext, false);
+        self.run(&mut ext, true);
+        cut(ext, edge, n)
+    }
+
+    /// [`Lowpass::filtfilt`] of each of `ys`, with the same numbers: up to [`LANES`]
+    /// signals of one length run side by side (the recursion of one signal is a chain
+    /// of dependent multiply-adds; independent signals fill the time between them).
+    pub fn filtfilt_many(&self, ys: &[&[f64]]) -> Vec<Vec<f64>> {
+        let ns = self.sections.len();
+        if !(1..=4).contains(&ns) {
+            return ys.iter().map(|y| self.filtfilt(y)).collect();
+        }
+        let mut out: Vec<Vec<f64>> = vec![Vec::new(); ys.len()];
+        // the signals of each length, in order
+        let mut groups: Vec<(usize, Vec<usize>)> = Vec::new();
+        for (j, y) in ys.iter().enumerate() {
+            match groups.iter_mut().find(|(n, _)| *n == y.len()) {
+                Some((_, g)) => g.push(j),
+                None => groups.push((y.len(), vec![j])),
+            }
+        }
+        for (n, group) in groups {
+            for chunk in group.chunks(LANES) {
+                if n == 0 || chunk.len() == 1 {
+                    for &j in chunk {
+                        out[j] = self.filtfilt(ys[j]);
+                    }
+                    continue;
+                }
+                // the extensions side by side, sample by sample (zeros in unused lanes)
+                let edge = self.padlen.min(n - 1);
+                let mut buf = vec![[0.0f64; LANES]; n + 2 * edge];
+                for (l, &j) in chunk.iter().enumerate() {
+                    let y = ys[j];
+                    let (first, last) = (y[0], y[n - 1]);
+                    for k in 0..edge {
+                        buf[k][l] = 2.0 * first - y[edge - k];
+                        buf[edge + n + k][l] = 2.0 * last - y[n - 2 - k];
+                    }
+                    for (b, &v) in buf[edge..edge + n].iter_mut().zip(y) {
+                        b[l] = v;
+                    }
+                }
+                self.run_lanes(&mut buf, false);
+                self.run_lanes(&mut buf, true);
+                for (l, &j) in chunk.iter().enumerate() {
+                    out[j] = buf[edge..edge + n].iter().map(|b| b[l]).collect();
+                }
+            }
+        }
+        out
+    }
+
+    /// The odd extension of `y` (not empty) by `edge = min(padlen, len - 1)` samples at
+    /// both ends, and `edge`.
+    fn extend(&self, y: &[f64]) -> (Vec<f64>, usize) {
+        let n = y.len();
         let edge = self.padlen.min(n - 1);
         let mut ext = Vec::with_capacity(n + 2 * edge);
         let (first, last) = (y[0], y[n - 1]);
@@ -157,13 +259,88 @@ impl Lowpass {
         for k in 1..=edge {
             ext.push(2.0 * last - y[n - 1 - k]);
         }
-        // forward, then backward from the last output (SciPy reverses the signal twice)
-        self.run(&mut ext, false);
-        self.run(&mut ext, true);
-        ext.drain(..edge);
-        ext.truncate(n);
-        ext
+        (ext, edge)
     }
+
+    /// [`Lowpass::run`] of [`LANES`] signals of one length side by side, stored sample
+    /// by sample (1 to 4 sections).
+    fn run_lanes(&self, buf: &mut [[f64; LANES]], backward: bool) {
+        match self.sections.len() {
+            1 => self.lanes::<1>(buf, backward),
+            2 => self.lanes::<2>(buf, backward),
+            3 => self.lanes::<3>(buf, backward),
+            _ => self.lanes::<4>(buf, backward),
+        }
+    }
+
+    /// [`Lowpass::run_n`] of [`LANES`] signals side by side: every operation of one
+    /// signal's run on all lanes at once (the same numbers lane by lane).
+    #[inline(always)]
+    fn lanes<const N: usize>(&self, buf: &mut [[f64; LANES]], backward: bool) {
+        const L: usize = LANES;
+        let mut c = [[0.0f64; 6]; N];
+        c.copy_from_slice(&self.sections[..N]);
+        let len = buf.len();
+        let x0 = if backward { buf[len - 1] } else { buf[0] };
+        let mut s0 = [[0.0f64; L]; N];
+        let mut s1 = [[0.0f64; L]; N];
+        for j in 0..N {
+            for l in 0..L {
+                s0[j][l] = self.zi[j][0] * x0[l];
+                s1[j][l] = self.zi[j][1] * x0[l];
+            }
+        }
+        if backward {
+            for block in buf.rchunks_mut(FLUSH_EVERY) {
+                for b in block.iter_mut().rev() {
+                    *b = step_lanes(&c, &mut s0, &mut s1, *b);
+                }
+                flush(&mut s0);
+                flush(&mut s1);
+            }
+        } else {
+            for block in buf.chunks_mut(FLUSH_EVERY) {
+                for b in block.iter_mut() {
+                    *b = step_lanes(&c, &mut s0, &mut s1, *b);
+                }
+                flush(&mut s0);
+                flush(&mut s1);
+            }
+        }
+    }
+}
+
+/// One sample of [`LANES`] signals through `N` sections: [`step_n`] lane by lane, each
+/// operation on all lanes at once.
+#[inline(always)]
+fn step_lanes<const N: usize>(
+    c: &[[f64; 6]; N],
+    s0: &mut [[f64; LANES]; N],
+    s1: &mut [[f64; LANES]; N],
+    mut x: [f64; LANES],
+) -> [f64; LANES] {
+    for j in 0..N {
+        let cj = c[j];
+        let mut out = [0.0f64; LANES];
+        for l in 0..LANES {
+            out[l] = cj[0] * x[l] + s0[j][l];
+        }
+        for l in 0..LANES {
+            s0[j][l] = cj[1] * x[l] - cj[4] * out[l] + s1[j][l];
+        }
+        for l in 0..LANES {
+            s1[j][l] = cj[2] * x[l] - cj[5] * out[l];
+        }
+        x = out;
+    }
+    x
+}
+
+/// The signal of `n` samples in an extension by `edge` samples at both ends.
+fn cut(mut ext: Vec<f64>, edge: usize, n: usize) -> Vec<f64> {
+    ext.drain(..edge);
+    ext.truncate(n);
+    ext
 }
 
 #[cfg(test)]
@@ -186,6 +363,92 @@ mod tests {
         for v in y {
             assert!((v - 3.5).abs() < 1e-12, "{v}");
         }
+    }
+
+    #[test]
+    fn a_pulse_decays_to_zero_not_through_subnormals() {
+        // a pulse, then 20 000 zeros: without the flush the states fall through the
+        // subnormal numbers and cycle among the smallest of them to the end
+        let s = [
+            0.020083365564211232,
+            0.040166731128422464,
+            0.020083365564211232,
+            1.0,
+            -1.5610180758007182,
+            0.6413515380575631,
+        ];
+        let mut y = vec![0.0; 20_000];
+        y[100] = 1.0;
+        for sections in [vec![s, s], vec![s; 5]] {
+            let f = Lowpass::new(sections, 12).unwrap();
+            let out = f.filtfilt(&y);
+            assert!(out
+                .iter()
+                .all(|v| *v == 0.0 || v.abs() >= f64::MIN_POSITIVE));
+            assert!(out[19_000..].iter().all(|v| *v == 0.0));
+            // where the signal is far above the flush level, the plain cascade's numbers
+            let mut plain = Lowpass::identity();
+            plain.sections = f.sections.clone();
+            plain.zi = f.zi.clone();
+            let mut fw = y.clone();
+            let mut st = vec![[0.0f64; 2]; plain.sections.len()];
+            for pass in 0..2 {
+                let idx: Vec<usize> = if pass == 0 {
+                    (0..fw.len()).collect()
+                } else {
+                    (0..fw.len()).rev().collect()
+                };
+                st.iter_mut().for_each(|s| *s = [0.0, 0.0]);
+                for k in idx {
+                    let mut x = fw[k];
+                    for (c, s) in plain.sections.iter().zip(st.iter_mut()) {
+                        let o = c[0] * x + s[0];
+                        s[0] = c[1] * x - c[4] * o + s[1];
+                        s[1] = c[2] * x - c[5] * o;
+                        x = o;
+                    }
+                    fw[k] = x;
+                }
+            }
+            for (a, b) in out.iter().zip(&fw) {
+                assert!(b.abs() < 1e-250 || a == b, "{a} {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn side_by_side_as_one_at_a_time() {
+        let s = [
+            0.020083365564211232,
+            0.040166731128422464,
+            0.020083365564211232,
+            1.0,
+            -1.5610180758007182,
+            0.6413515380575631,
+        ];
+        let sig = |j: usize, n: usize| -> Vec<f64> {
+            (0..n)
+                .map(|k| ((k * (j + 3)) as f64 * 0.01).sin() + if k == 40 { 1e3 } else { 0.0 })
+                .collect()
+        };
+        // lengths 1, 7 (shorter than the extension) and 300; groups of 1 to 4 and 5
+        let ys: Vec<Vec<f64>> = (0..14)
+            .map(|j| sig(j, [300, 7, 300, 1, 300][j % 5]))
+            .collect();
+        let refs: Vec<&[f64]> = ys.iter().map(|y| y.as_slice()).collect();
+        for n in 1..=5 {
+            let f = Lowpass::new(vec![s; n], 9).unwrap();
+            for take in [2, 3, 4, 5, 14] {
+                let many = f.filtfilt_many(&refs[..take]);
+                assert_eq!(many.len(), take);
+                for (y, got) in refs.iter().zip(&many) {
+                    let one = f.filtfilt(y);
+                    assert!(one.iter().zip(got).all(|(a, b)| a.to_bits() == b.to_bits()));
+                    assert_eq!(one.len(), got.len());
+                }
+            }
+        }
+        assert!(Lowpass::identity().filtfilt_many(&refs)[3] == ys[3]);
     }
 
     #[test]

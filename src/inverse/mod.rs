@@ -21,11 +21,12 @@
 mod filter;
 mod spectrum;
 
-pub use filter::Lowpass;
+pub use filter::{Lowpass, LANES};
 pub use spectrum::{position_sums, PositionSums, MAX_FREQUENCIES, RESEED};
 
 use crate::error::{check_finite, check_len, Error, Result};
 use crate::friction::{LugreParams, StaticSet};
+use crate::servo::coupling::coupling_forces;
 use crate::servo::fast::{Fast, Power, Shape, Square};
 use crate::servo::{coupling_force, CouplingOptions, Effect, Model};
 
@@ -83,17 +84,21 @@ impl BaseParam {
         }
     }
 
-    /// `(d g/d theta, d sigma2/d theta)` of the set that acts at `v` (unscaled).
+    /// `(d g/d theta, d sigma2/d theta)` of the set that acts at the speed where
+    /// `stribeck_e` gives `(e, pw)` (unscaled).
     #[inline(always)]
-    fn dg(self, set: &StaticSet<f64>, positive: bool, v: f64, exponent: f64) -> (f64, f64) {
+    fn dg(
+        self,
+        set: &StaticSet<f64>,
+        positive: bool,
+        (e, pw): (f64, f64),
+        exponent: f64,
+    ) -> (f64, f64) {
         let own = |p: bool| p == positive;
         match self {
-            BaseParam::Fc(p) if own(p) => (1.0 - stribeck_e(set, v, exponent).0, 0.0),
-            BaseParam::Fs(p) if own(p) => (stribeck_e(set, v, exponent).0, 0.0),
-            BaseParam::Vs(p) if own(p) => {
-                let (e, pw) = stribeck_e(set, v, exponent);
-                ((set.fs - set.fc) * e * exponent * pw / set.vs, 0.0)
-            }
+            BaseParam::Fc(p) if own(p) => (1.0 - e, 0.0),
+            BaseParam::Fs(p) if own(p) => (e, 0.0),
+            BaseParam::Vs(p) if own(p) => ((set.fs - set.fc) * e * exponent * pw / set.vs, 0.0),
             BaseParam::Sigma2(p) if own(p) => (0.0, 1.0),
             _ => (0.0, 0.0),
         }
@@ -250,6 +255,18 @@ impl Record {
         self.filter.filtfilt(y)
     }
 
+    /// [`Record::filt`] of several signals of the record's length, side by side
+    /// ([`Lowpass::filtfilt_many`]) and in parallel (rayon).
+    pub fn filt_many(&self, ys: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        use rayon::prelude::*;
+        ys.par_chunks(LANES)
+            .flat_map_iter(|chunk| {
+                let refs: Vec<&[f64]> = chunk.iter().map(Vec::as_slice).collect();
+                self.filter.filtfilt_many(&refs)
+            })
+            .collect()
+    }
+
     /// Product of the `position_friction` and `drift` scales, in the order of the
     /// effects, or `None` without them.
     pub fn friction_scale(&self, model: &Model) -> Option<Vec<f64>> {
@@ -354,35 +371,74 @@ impl Record {
     /// along the drive motion with its friction, the friction scales and the effect
     /// forces on it.
     pub fn coupling_force(&self, model: &Model) -> Result<Vec<f64>> {
-        let scale = self.friction_scale(model);
-        let extra = self.effect_force(model);
-        let opts = CouplingOptions {
-            scale: scale.as_deref(),
-            extra: Some(&extra),
+        let (scale, extra) = self.load_forces(model);
+        let opts = self.coupling_options(scale.as_deref(), &extra);
+        coupling_force(model, &self.x_drive, &self.v, self.dt, &opts)
+    }
+
+    /// The friction scale and the effect forces acting on the load of a `resonance`.
+    fn load_forces(&self, model: &Model) -> (Option<Vec<f64>>, Vec<f64>) {
+        (self.friction_scale(model), self.effect_force(model))
+    }
+
+    /// The options of the load simulation of [`Record::coupling_force`].
+    fn coupling_options<'a>(
+        &self,
+        scale: Option<&'a [f64]>,
+        extra: &'a [f64],
+    ) -> CouplingOptions<'a> {
+        CouplingOptions {
+            scale,
+            extra: Some(extra),
             z0: 0.0,
             substeps: COUPLING_SUBSTEPS,
-        };
-        coupling_force(model, &self.x_drive, &self.v, self.dt, &opts)
+        }
+    }
+
+    /// The `load_fraction` of the model's `resonance`, if it has one.
+    fn load_fraction(model: &Model) -> Option<f64> {
+        model.effects.iter().find_map(|e| match e {
+            Effect::Resonance { load_fraction, .. } => Some(*load_fraction),
+            _ => None,
+        })
     }
 
     /// Filtered force the model needs besides the motor: `m*a + F_friction + F_effects`
     /// (with a `resonance`: `(1 - r)*m*a + F_coupling`).
     pub fn model_force(&self, model: &Model) -> Result<Vec<f64>> {
+        let coupling = match Self::load_fraction(model) {
+            None => None,
+            Some(_) => Some(self.coupling_force(model)?),
+        };
+        Ok(self.model_force_with(model, coupling))
+    }
+
+    /// [`Record::model_force`] with the unfiltered coupling force of a model with a
+    /// `resonance` given.
+    fn model_force_with(&self, model: &Model, coupling: Option<Vec<f64>>) -> Vec<f64> {
+        let (ma, f) = self.model_force_raw(model, coupling);
+        self.add_inertia(ma, &self.filt(&f))
+    }
+
+    /// The mass that the measured acceleration moves and the unfiltered force the model
+    /// needs besides it: `(m, F_friction + F_effects)`, with a `resonance` (its
+    /// coupling force given) `((1 - r)*m, F_coupling)`.
+    fn model_force_raw(&self, model: &Model, coupling: Option<Vec<f64>>) -> (f64, Vec<f64>) {
         let m = model.total_mass();
-        let res = model.effects.iter().find_map(|e| match e {
-            Effect::Resonance { load_fraction, .. } => Some(*load_fraction),
-            _ => None,
-        });
-        let (ma, f) = match res {
-            None => {
+        match (Self::load_fraction(model), coupling) {
+            (Some(r), Some(fc)) => ((1.0 - r) * m, fc),
+            _ => {
                 let mut f = self.base_friction(model);
                 let e = self.effect_force(model);
                 f.iter_mut().zip(&e).for_each(|(a, b)| *a += b);
-                (m, self.filt(&f))
+                (m, f)
             }
-            Some(r) => ((1.0 - r) * m, self.filt(&self.coupling_force(model)?)),
-        };
-        Ok(self.a.iter().zip(&f).map(|(a, f)| ma * a + f).collect())
+        }
+    }
+
+    /// `ma*a + f`.
+    fn add_inertia(&self, ma: f64, f: &[f64]) -> Vec<f64> {
+        self.a.iter().zip(f).map(|(a, f)| ma * a + f).collect()
     }
 
     /// Filtered motor force after the model's `delay`, `deadband` and `current_lag`
@@ -429,10 +485,85 @@ impl Record {
     }
 
     /// [`Record::residual`] of several models, in parallel (rayon); the first error
-    /// in the order of `models` when any fails.
+    /// in the order of `models` when any fails. The load simulations of the models
+    /// with a `resonance` run interleaved, several in one loop
+    /// ([`crate::servo::coupling::LANES`]), and so do their low-passes
+    /// ([`Lowpass::filtfilt_many`]); the results are those of one at a time.
     pub fn residuals(&self, models: &[Model]) -> Result<Vec<Vec<f64>>> {
         use rayon::prelude::*;
-        models.par_iter().map(|m| self.residual(m)).collect()
+        let (coupled, plain): (Vec<usize>, Vec<usize>) =
+            (0..models.len()).partition(|&j| Self::load_fraction(&models[j]).is_some());
+        let mut out: Vec<Option<Result<Vec<f64>>>> = (0..models.len()).map(|_| None).collect();
+        // the models with a resonance: their load simulations side by side, then (in
+        // the cache) the low-passes of those forces side by side
+        let loads: Vec<(Option<Vec<f64>>, Vec<f64>)> = coupled
+            .par_iter()
+            .map(|&j| self.load_forces(&models[j]))
+            .collect();
+        let jobs: Vec<(&Model, CouplingOptions)> = coupled
+            .iter()
+            .zip(&loads)
+            .map(|(&j, (s, e))| (&models[j], self.coupling_options(s.as_deref(), e)))
+            .collect();
+        let done = coupling_forces(&jobs, &self.x_drive, &self.v, self.dt, |idx, forces| {
+            let ms: Vec<&Model> = idx.iter().map(|&i| &models[coupled[i]]).collect();
+            let mut raw = Vec::with_capacity(idx.len());
+            let mut errors = Vec::new();
+            for (k, f) in forces.into_iter().enumerate() {
+                match f {
+                    Ok(fc) => raw.push((k, self.model_force_raw(ms[k], Some(fc)))),
+                    Err(e) => errors.push((k, e)),
+                }
+            }
+            let mut res: Vec<Option<Result<Vec<f64>>>> = (0..idx.len()).map(|_| None).collect();
+            for (k, r) in self.finish(&ms, raw) {
+                res[k] = Some(Ok(r));
+            }
+            for (k, e) in errors {
+                res[k] = Some(Err(e));
+            }
+            res.into_iter().map(|r| r.expect("one result")).collect()
+        });
+        for (&j, r) in coupled.iter().zip(done) {
+            out[j] = Some(r);
+        }
+        // the others: friction and effect forces, low-passed side by side
+        let done: Vec<(usize, Vec<f64>)> = plain
+            .par_chunks(LANES)
+            .flat_map_iter(|chunk| {
+                let ms: Vec<&Model> = chunk.iter().map(|&j| &models[j]).collect();
+                let raw = (0..chunk.len())
+                    .map(|k| (k, self.model_force_raw(ms[k], None)))
+                    .collect();
+                self.finish(&ms, raw)
+                    .into_iter()
+                    .map(|(k, r)| (chunk[k], r))
+            })
+            .collect();
+        for (j, r) in done {
+            out[j] = Some(Ok(r));
+        }
+        out.into_iter()
+            .map(|r| r.expect("every model has a residual"))
+            .collect()
+    }
+
+    /// The residuals of models (`ms[k]`) from their unfiltered model forces
+    /// ([`Record::model_force_raw`], by index `k`), the low-passes side by side.
+    fn finish(&self, ms: &[&Model], raw: Vec<(usize, (f64, Vec<f64>))>) -> Vec<(usize, Vec<f64>)> {
+        let ys: Vec<&[f64]> = raw.iter().map(|(_, (_, f))| f.as_slice()).collect();
+        let filtered = self.filter.filtfilt_many(&ys);
+        raw.iter()
+            .zip(&filtered)
+            .map(|((k, (ma, _)), f)| {
+                // motor force minus what the model needs, `ma*a + f`
+                let mut r = self.motor_force(ms[*k]);
+                for ((r, a), f) in r.iter_mut().zip(&self.a).zip(f) {
+                    *r -= ma * a + f;
+                }
+                (*k, r)
+            })
+            .collect()
     }
 
     /// The LuGre force of [`Record::base_friction`] and its filtered derivatives with
@@ -461,8 +592,10 @@ impl Record {
             let g = sc * g_of(p, v, exponent);
             let w = v - s0 * v.abs() * z / g;
             force[k] = s0 * z + s1 * w + set.sigma2 * v;
+            // (one exponential for every parameter of the set; unused without fc, fs, vs)
+            let e = stribeck_e(set, v, ex);
             for (j, par) in params.iter().enumerate() {
-                let (dg0, ds2) = par.dg(set, pos, v, ex);
+                let (dg0, ds2) = par.dg(set, pos, e, ex);
                 let dg = sc * dg0;
                 let ds0 = if *par == BaseParam::Sigma0 { 1.0 } else { 0.0 };
                 let ds1 = if *par == BaseParam::Sigma1 { 1.0 } else { 0.0 };
@@ -484,8 +617,9 @@ impl Record {
             let sign = if u > 0.0 { 1.0 } else { -1.0 };
             let zss = sign * gh / s0;
             let e = (-(s0 * u.abs() * self.dt / gh)).exp();
+            let eu = stribeck_e(uset, u, ex);
             for (j, par) in params.iter().enumerate() {
-                let dgh = su * par.dg(uset, upos, u, ex).0;
+                let dgh = su * par.dg(uset, upos, eu, ex).0;
                 let ds0 = if *par == BaseParam::Sigma0 { 1.0 } else { 0.0 };
                 let dzss = sign * (dgh / s0 - gh * ds0 / (s0 * s0));
                 let da = u.abs() * self.dt * (ds0 / gh - s0 * dgh / (gh * gh));
@@ -494,7 +628,7 @@ impl Record {
             z = p.advance_z(z, u, gh, self.dt);
         }
         let nonzero = cols.iter().map(|c| c.iter().any(|&x| x != 0.0)).collect();
-        let columns = cols.iter().map(|c| self.filt(c)).collect();
+        let columns = self.filt_many(&cols);
         Sensitivities {
             force,
             columns,

@@ -91,6 +91,16 @@ fn columns(n: usize, cols: &[Vec<f64>]) -> Array2<f64> {
     Array2::from_shape_fn((n, cols.len()), |(k, j)| cols[j][k])
 }
 
+/// Columns of equal length `n` as an `(n, columns)` matrix stored column by column
+/// (each column contiguous: the caller reads them one at a time).
+fn columns_major(n: usize, cols: Vec<Vec<f64>>) -> Array2<f64> {
+    let m = cols.len();
+    let data: Vec<f64> = cols.into_iter().flatten().collect();
+    Array2::from_shape_vec((m, n), data)
+        .expect("columns of equal length")
+        .reversed_axes()
+}
+
 #[pymethods]
 impl PyInverseRecord {
     #[new]
@@ -156,6 +166,31 @@ impl PyInverseRecord {
         let ys = slice("y", &y).map_err(|e| to_py(py, e))?;
         crate::error::check_len("y", ys, self.rec.len(), "the record").map_err(|e| to_py(py, e))?;
         Ok(py.detach(|| self.rec.filt(ys)).into_pyarray(py))
+    }
+
+    /// The parallel low-pass of each column of an `(n, m)` matrix, several side by side.
+    fn filt_columns<'py>(
+        &self,
+        py: Python<'py>,
+        y: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let a = y.as_array();
+        let n = self.rec.len();
+        if a.nrows() != n {
+            return Err(to_py(
+                py,
+                Error::input(
+                    "y",
+                    format!(
+                        "has {} rows but the record has {n} samples: give one row per sample",
+                        a.nrows()
+                    ),
+                ),
+            ));
+        }
+        let cols: Vec<Vec<f64>> = a.columns().into_iter().map(|c| c.to_vec()).collect();
+        let out = py.detach(|| self.rec.filt_many(&cols));
+        Ok(columns(n, &out).into_pyarray(py))
     }
 
     /// Product of the position and drift scales of friction, or None.
@@ -234,7 +269,7 @@ impl PyInverseRecord {
         let cols = py
             .detach(|| self.rec.residuals(&ms))
             .map_err(|e| to_py(py, e))?;
-        Ok(columns(n, &cols).into_pyarray(py))
+        Ok(columns_major(n, cols).into_pyarray(py))
     }
 
     /// `(force, J, nonzero)`: the unfiltered LuGre force, its filtered derivatives with

@@ -234,6 +234,196 @@ pub(crate) fn coupling_force(
     Ok(force)
 }
 
+/// Load simulations run interleaved in one loop by [`coupling_forces`]: each is a
+/// chain of dependent operations (divisions, `exp`) that leaves the processor idle
+/// between them, and independent chains fill that time.
+pub(crate) const LANES: usize = 4; // (run_lanes has a loop for each width up to it)
+
+/// The coupling forces of several load simulations along one motor motion, as
+/// [`coupling_force`] of each `(model, options)` (bit for bit), up to [`LANES`] at a
+/// time interleaved in one loop, the loops in parallel (rayon): simulations with the
+/// same number of substeps and the same Stribeck shape share a loop. Each loop's
+/// forces go to `then` with the indices of their jobs while they are in the cache;
+/// `then` returns one result per job of the loop (the forces themselves: `|_, f| f`).
+#[cfg(feature = "std")]
+pub(crate) fn coupling_forces<T: Send>(
+    jobs: &[(&Model, CouplingOptions<'_>)],
+    x: &[f64],
+    v: &[f64],
+    dt: f64,
+    then: impl Fn(&[usize], Vec<Result<Vec<f64>>>) -> Vec<Result<T>> + Sync,
+) -> Vec<Result<T>> {
+    use rayon::prelude::*;
+    let mut out: Vec<Option<Result<T>>> = Vec::with_capacity(jobs.len());
+    let mut ready: Vec<Ready> = Vec::new();
+    for (j, (m, o)) in jobs.iter().enumerate() {
+        let checked = Coupling::from_model(m)
+            .and_then(|cp| check_inputs(&cp, x, v, dt, o).map(|n_sub| (cp, n_sub)));
+        match checked {
+            Ok((cp, n_sub)) => {
+                ready.push(Ready {
+                    n_sub,
+                    exponent: cp.exponent.map(f64::to_bits),
+                    job: j,
+                    cp,
+                });
+                out.push(None);
+            }
+            Err(e) => out.push(Some(Err(e))),
+        }
+    }
+    // jobs of one loop side by side (stable: in the order of the jobs), then at most
+    // LANES a loop, fewer when that leaves threads idle
+    ready.sort_by_key(|r| (r.n_sub, r.exponent));
+    let width = ready
+        .len()
+        .div_ceil(rayon::current_num_threads().max(1))
+        .clamp(1, LANES);
+    let mut chunks: Vec<&[Ready]> = Vec::new();
+    for group in ready.chunk_by(|a, b| (a.n_sub, a.exponent) == (b.n_sub, b.exponent)) {
+        chunks.extend(group.chunks(width));
+    }
+    let done: Vec<(usize, Result<T>)> = chunks
+        .par_iter()
+        .flat_map_iter(|chunk| {
+            let lanes: Vec<(&Coupling, &CouplingOptions)> =
+                chunk.iter().map(|r| (&r.cp, &jobs[r.job].1)).collect();
+            let idx: Vec<usize> = chunk.iter().map(|r| r.job).collect();
+            let forces = run_lanes(&lanes, x, v, dt, chunk[0].n_sub);
+            let results = then(&idx, forces);
+            assert_eq!(results.len(), idx.len(), "one result per job");
+            idx.into_iter().zip(results)
+        })
+        .collect();
+    for (j, f) in done {
+        out[j] = Some(f);
+    }
+    out.into_iter()
+        .map(|r| r.expect("every job has a result"))
+        .collect()
+}
+
+/// A job of [`coupling_forces`] with checked inputs: its loop (substeps, Stribeck
+/// exponent), its index and its coupling.
+#[cfg(feature = "std")]
+struct Ready {
+    n_sub: usize,
+    exponent: Option<u64>,
+    job: usize,
+    cp: Coupling,
+}
+
+/// [`run`] of up to [`LANES`] loads with `n_sub` substeps and one Stribeck shape,
+/// interleaved (no load trajectory kept).
+#[cfg(feature = "std")]
+fn run_lanes(
+    lanes: &[(&Coupling, &CouplingOptions)],
+    x: &[f64],
+    v: &[f64],
+    dt: f64,
+    n_sub: usize,
+) -> Vec<Result<Vec<f64>>> {
+    let exponent = lanes[0].0.exponent;
+    macro_rules! width {
+        ($shape:expr) => {
+            match lanes.len() {
+                1 => run_width::<_, 1>($shape, lanes, x, v, dt, n_sub),
+                2 => run_width::<_, 2>($shape, lanes, x, v, dt, n_sub),
+                3 => run_width::<_, 3>($shape, lanes, x, v, dt, n_sub),
+                _ => run_width::<_, 4>($shape, lanes, x, v, dt, n_sub),
+            }
+        };
+    }
+    match exponent {
+        None => width!(Square),
+        Some(e) => width!(Power(e)),
+    }
+}
+
+/// [`run_lanes`] with `L` lanes.
+#[cfg(feature = "std")]
+#[inline(always)]
+fn run_width<S: Shape, const L: usize>(
+    shape: S,
+    lanes: &[(&Coupling, &CouplingOptions)],
+    x: &[f64],
+    v: &[f64],
+    dt: f64,
+    n_sub: usize,
+) -> Vec<Result<Vec<f64>>> {
+    assert_eq!(lanes.len(), L, "one lane per simulation");
+    let n = x.len();
+    let mut force: [Vec<f64>; L] = core::array::from_fn(|_| vec![0.0; n]);
+    if n == 0 {
+        return force.into_iter().map(Ok).collect();
+    }
+    let (x, v) = (&x[..n], &v[..n]);
+    let cp: [&Coupling; L] = core::array::from_fn(|l| lanes[l].0);
+    let op: [&CouplingOptions; L] = core::array::from_fn(|l| lanes[l].1);
+    let fr: [Fast; L] = core::array::from_fn(|l| Fast::new(&cp[l].friction, cp[l].exponent));
+    let k: [f64; L] = core::array::from_fn(|l| cp[l].k);
+    let c: [f64; L] = core::array::from_fn(|l| cp[l].c);
+    let ml: [f64; L] = core::array::from_fn(|l| cp[l].ml);
+    let h = dt / n_sub as f64;
+    let nf = n_sub as f64;
+    let fracs: Vec<f64> = (1..n_sub).map(|j| j as f64 / nf).collect();
+    let mut xl = [x[0]; L];
+    let mut vl = [v[0]; L];
+    let mut z: [f64; L] = core::array::from_fn(|l| op[l].z0);
+    let mut bad: [Option<usize>; L] = [None; L];
+    for i in 0..n {
+        let (x0, v0) = (x[i], v[i]);
+        for l in 0..L {
+            force[l][i] = k[l] * (x0 - xl[l]) + c[l] * (v0 - vl[l]);
+        }
+        if i + 1 == n {
+            break;
+        }
+        let s: [f64; L] = core::array::from_fn(|l| op[l].scale.map_or(1.0, |a| a[i]));
+        let fe: [f64; L] = core::array::from_fn(|l| op[l].extra.map_or(0.0, |a| a[i]));
+        let (dx, dv) = (x[i + 1] - x0, v[i + 1] - v0);
+        // the substeps of every lane, as the `step` of `run_shaped`
+        let mut sub = |xm: f64, vm: f64| {
+            for l in 0..L {
+                let fs = k[l] * (xm - xl[l]) + c[l] * (vm - vl[l]);
+                let (g, ff) = fr[l].eval(shape, z[l], vl[l], s[l]);
+                let al = (fs - ff - fe[l]) / ml[l];
+                z[l] = fr[l].advance_z(z[l], vl[l], g, h);
+                vl[l] += al * h;
+                xl[l] += vl[l] * h;
+            }
+        };
+        sub(x0, v0);
+        for &f in &fracs {
+            sub(x0 + dx * f, v0 + dv * f);
+        }
+        for l in 0..L {
+            if bad[l].is_none() && !(xl[l].is_finite() && vl[l].is_finite() && z[l].is_finite()) {
+                bad[l] = Some(i);
+            }
+        }
+        if bad.iter().all(Option::is_some) {
+            break;
+        }
+    }
+    force
+        .into_iter()
+        .zip(bad)
+        .map(|(f, b)| match b {
+            None => Ok(f),
+            Some(i) => Err(diverged(i)),
+        })
+        .collect()
+}
+
+/// The error of a load that diverged after sample `i`.
+fn diverged(i: usize) -> Error {
+    Error::Data(format!(
+        "the load behind the coupling diverged after sample {i}: check the \
+         motor motion and the model's resonance"
+    ))
+}
+
 /// The load's position, velocity and bristle state at the samples.
 type LoadOut<'a> = Option<(&'a mut [f64], &'a mut [f64], &'a mut [f64])>;
 
@@ -313,10 +503,7 @@ fn run_shaped<S: Shape>(
             step(x0 + dx * f, v0 + dv * f, s, fe, &mut xl, &mut vl, &mut z);
         }
         if !(xl.is_finite() && vl.is_finite() && z.is_finite()) {
-            return Err(Error::Data(format!(
-                "the load behind the coupling diverged after sample {i}: check the \
-                 motor motion and the model's resonance"
-            )));
+            return Err(diverged(i));
         }
     }
     Ok(())
@@ -393,6 +580,78 @@ mod tests {
         );
         let r = load_coupling(&m, &[], &[], 1e-4, &o).unwrap();
         assert!(r.force.is_empty());
+    }
+
+    #[test]
+    fn interleaved_as_one_at_a_time() {
+        // eleven loads of three loops (substeps, Stribeck exponent), one of them
+        // diverging, one without a resonance, one with an error of its options
+        let dt = 1e-3;
+        let n = 3000;
+        let x: Vec<f64> = (0..n).map(|k| 0.02 * (2.1 * k as f64 * dt).sin()).collect();
+        let v: Vec<f64> = (0..n)
+            .map(|k| 0.042 * (2.1 * k as f64 * dt).cos())
+            .collect();
+        let scale: Vec<f64> = (0..n).map(|k| 1.0 + 0.1 * (k as f64 * dt).sin()).collect();
+        let extra: Vec<f64> = (0..n).map(|k| (3.0 * k as f64 * dt).cos()).collect();
+        let mut models = Vec::new();
+        for (j, f) in [8.0, 15.0, 22.0, 31.0, 45.0, 60.0, 400.0]
+            .iter()
+            .enumerate()
+        {
+            let mut m = model();
+            m.effects[0] = Effect::Resonance {
+                frequency_hz: *f,
+                damping_ratio: 0.03 + 0.05 * j as f64,
+                load_fraction: 0.2 + 0.1 * j as f64,
+            };
+            if j % 3 == 1 {
+                m.effects.push(Effect::StribeckShape { exponent: 1.4 });
+            }
+            models.push(m);
+        }
+        // negative damping: the load's swing grows until it overflows
+        models[2].effects[0] = Effect::Resonance {
+            frequency_hz: 30.0,
+            damping_ratio: -20.0,
+            load_fraction: 0.5,
+        };
+        models.push(Model::paper());
+        models.push(model());
+        models.push(model());
+        let plain = CouplingOptions {
+            substeps: 4,
+            ..Default::default()
+        };
+        let shaped = CouplingOptions {
+            scale: Some(&scale),
+            extra: Some(&extra),
+            z0: 1e-5,
+            substeps: 2,
+        };
+        let wrong = CouplingOptions {
+            extra: Some(&extra[1..]),
+            ..plain
+        };
+        let mut opts: Vec<CouplingOptions> = (0..7).map(|j| [plain, shaped][j % 2]).collect();
+        opts.extend([plain, wrong, plain]);
+        let jobs: Vec<(&Model, CouplingOptions)> = models.iter().zip(opts).collect();
+        let all = coupling_forces(&jobs, &x, &v, dt, |_, f| f);
+        assert_eq!(all.len(), jobs.len());
+        let mut errors = 0;
+        for ((m, o), got) in jobs.iter().zip(&all) {
+            match (coupling_force(m, &x, &v, dt, o), got) {
+                (Ok(a), Ok(b)) => {
+                    assert!(a.iter().zip(b).all(|(p, q)| p.to_bits() == q.to_bits()));
+                }
+                (Err(a), Err(b)) => {
+                    assert_eq!(a.to_string(), b.to_string());
+                    errors += 1;
+                }
+                (a, b) => panic!("{a:?} against {b:?}"),
+            }
+        }
+        assert_eq!(errors, 3, "{all:?}");
     }
 
     #[test]

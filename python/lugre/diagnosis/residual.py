@@ -203,8 +203,7 @@ class Signals:
         y = np.asarray(y, dtype=float)
         if y.ndim == 1:
             return self.kernel.filt(y)
-        return np.column_stack([self.kernel.filt(np.ascontiguousarray(c)) for c in y.T]
-                               ) if y.shape[1] else y.copy()
+        return self.kernel.filt_columns(y)
 
     def __len__(self) -> int:
         return int(self.t.size)
