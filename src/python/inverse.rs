@@ -95,7 +95,10 @@ fn columns(n: usize, cols: &[Vec<f64>]) -> Array2<f64> {
 /// (each column contiguous: the caller reads them one at a time).
 fn columns_major(n: usize, cols: Vec<Vec<f64>>) -> Array2<f64> {
     let m = cols.len();
-    let data: Vec<f64> = cols.into_iter().flatten().collect();
+    let mut data: Vec<f64> = Vec::with_capacity(n * m);
+    for c in &cols {
+        data.extend_from_slice(c);
+    }
     Array2::from_shape_vec((m, n), data)
         .expect("columns of equal length")
         .reversed_axes()
