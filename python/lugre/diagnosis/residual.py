@@ -559,18 +559,29 @@ def reading_band(x: np.ndarray, fm: np.ndarray, fs: float, mass: float) -> float
     fm = np.asarray(fm, float)
     if x.size < 258:
         return None
-    level = hf_level(fm, fs)
-    steps = np.abs(np.diff(x))
-    q = float(np.min(steps[steps > 0])) if np.any(steps > 0) else 0.0
-    sx = q * q / 12.0 / (0.5 * fs)
-    read = hf_level(np.diff(x, 2), fs, lambda f: (2.0 - 2.0 * np.cos(2.0 * np.pi * f / fs)) ** 2)
-    sx = max(sx, read or 0.0)
+    level, _q, sq, read = reading_noises(x, fm, fs)
+    sx = max(sq, read or 0.0)
     if level is None or not level > 0 or not sx > 0 or not mass > 0:
         return None
     if level * 0.5 * fs < (1e-6 * float(np.std(fm))) ** 2:
         return None  # a force without noise (a simulation): nothing to balance against
     ratio2 = READING_NOISE_RATIO ** 2
     return float((5.0 * ratio2 * level / (mass * mass * sx)) ** 0.25 / (2.0 * np.pi))
+
+
+def reading_noises(x: np.ndarray, fm: np.ndarray, fs: float
+                   ) -> tuple[float | None, float, float, float | None]:
+    """The readings' white noise levels as the band and the checks read them: the
+    force's one-sided density above the motion's band (:func:`hf_level`), the position's
+    resolution ``q`` (smallest step), the density ``q^2/12/(fs/2)`` of its quantisation,
+    and the density its second difference shows above the band (None where a level
+    cannot be read: under 256 samples)."""
+    x = np.asarray(x, float)
+    level = hf_level(np.asarray(fm, float), fs)
+    q = _quantum(x)
+    sq = q * q / 12.0 / (0.5 * fs)
+    read = hf_level(np.diff(x, 2), fs, lambda f: (2.0 - 2.0 * np.cos(2.0 * np.pi * f / fs)) ** 2)
+    return level, q, sq, read
 
 
 def decimation(fs: float, cutoff_hz: float) -> int:

@@ -50,13 +50,9 @@ def surrogates(rec: Recording, model: Model, sig: R.Signals
     short to measure its noise."""
     fs = 1.0 / rec.dt
     force = rec.force(model)
-    fm, _ = R.hampel(force)
-    sf = R.hf_level(fm, fs) or 0.0
     x = np.asarray(rec.x, float)
-    q = R._quantum(x)
-    sq = q * q / 12.0 / (0.5 * fs)
-    read = R.hf_level(np.diff(x, 2), fs,
-                      lambda f: (2.0 - 2.0 * np.cos(2.0 * np.pi * f / fs)) ** 2) or 0.0
+    level, q, sq, read_ = R.reading_noises(x, R.hampel(force)[0], fs)
+    sf, read = level or 0.0, read_ or 0.0
     if not (sf > 0.0 or read > 0.0):
         return []
     rng = np.random.default_rng(SURROGATE_SEED)
