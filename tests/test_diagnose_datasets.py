@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import lugre
 import pytest
 from lugre.diagnosis import diagnose, fit_inverse_dynamics
+from shared_data import SHARED
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 MISMATCH = SHARED / "datasets" / "mismatch"
 EMPS = SHARED / "datasets" / "emps" / "emps_estimation.csv"
 

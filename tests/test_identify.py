@@ -7,13 +7,12 @@ import json
 import subprocess
 import sys
 import warnings
-from pathlib import Path
 
 import lugre
 import numpy as np
 import pytest
+from shared_data import SHARED
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 STATIC = SHARED / "datasets" / "static"
 needs_static = pytest.mark.skipif(not STATIC.is_dir(),
                                   reason=f"shared datasets not found at {STATIC}")

@@ -9,8 +9,6 @@ last bit.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import lugre
 import numpy as np
 import pytest
@@ -21,8 +19,8 @@ from lugre.diagnosis import residual as R
 from lugre.diagnosis.synth import concealed
 from lugre.exceptions import InputError, LugreError
 from scipy import signal
+from shared_data import SHARED
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 MISMATCH = SHARED / "datasets" / "mismatch"
 
 NAMES = ["positive.fc", "positive.fs", "positive.sigma2", "positive.vs", "negative.fc",

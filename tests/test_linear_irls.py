@@ -7,7 +7,6 @@ inverse-dynamics fit it serves gives what the NumPy IRLS it replaced gave."""
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import lugre
 import numpy as np
@@ -16,16 +15,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from lugre import _native
 from lugre import reference as ref
+from shared_data import shared_file
 
 BACKENDS = (_native, ref)
-SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "datasets"
-
-
-def shared_file(*parts):
-    p = SHARED.joinpath(*parts)
-    if not p.exists():
-        pytest.skip(f"shared dataset {p} is absent (expected ../shared next to the repo)")
-    return p
 
 
 def problem(seed, n, p, share, scale_spread=2.0):

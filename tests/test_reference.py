@@ -37,9 +37,7 @@ from lugre.exceptions import (
 )
 from lugre.io import Recording, read_recording, write_recording
 from lugre.model import Model, _as_model, load_model, save_model
-
-#: ``../shared`` next to the repository: data the project did not write.
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+from shared_data import SHARED  # ../shared: data the project did not write
 
 settings.register_profile("fast", max_examples=30, deadline=None)
 settings.register_profile("slow", max_examples=500, deadline=None)

@@ -13,7 +13,6 @@ import dataclasses
 import json
 import math
 import warnings
-from pathlib import Path
 
 import lugre
 import numpy as np
@@ -22,6 +21,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from lugre import reference as ref
 from lugre.model import Model
+from shared_data import shared_file
 
 BACKENDS = [lugre, ref]
 
@@ -577,14 +577,6 @@ def test_new_effects_save_round_trip(tmp_path):
 
 # ---- fit_static: variable projection + IRLS + Nelder-Mead ---------------------------------
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "datasets"
-
-
-def shared_file(*parts):
-    p = SHARED.joinpath(*parts)
-    if not p.exists():
-        pytest.skip(f"shared dataset {p} is absent (expected ../shared next to the repo)")
-    return p
 
 
 def assert_same_static(a, b, rel=0.0):
