@@ -31,11 +31,6 @@ def model(effects=None, **res):
     return lugre.Model.from_dict(d)
 
 
-def rel_max(a, b):
-    a, b = np.asarray(a), np.asarray(b)
-    return float(np.max(np.abs(a - b)) / max(np.max(np.abs(b)), 1e-300))
-
-
 # ------------------------------------------------------------------------------ twins
 
 
@@ -165,20 +160,22 @@ def _measured_coupling_force(m, i, sim):
     return m.force_constant * i[:-1] - mm * np.diff(sim.v) / DT
 
 
-def test_same_step_reproduces_the_simulation():
-    """One plant step per sample in the simulation and one substep here: the same
-    step on the load, so the forward-difference force, the bristle state and the
-    friction agree to rounding."""
+def test_second_order_while_sliding():
+    """Away from reversals and sticking the load step is second order: sliding forward
+    at 0.05-0.15 m/s (3 Hz swing, 1 kHz samples), the force's error against a
+    256-fold-substep run falls fourfold per doubling of the substeps (measured 4.08,
+    4.04, 4.02; semi-implicit Euler would give 2)."""
     m = model()
-    _, i, sim = _open_loop(m, 1)
-    assert np.ptp(sim.v) > 0.2 and np.sum(np.diff(np.sign(sim.v)) != 0) >= 4
-    r = lugre.load_coupling(sim.x, sim.v, DT, m)
-    fm = _measured_coupling_force(m, i, sim)
-    err = np.sqrt(np.mean((r.force[:-1] - fm) ** 2)) / np.sqrt(np.mean(fm**2))
-    assert err < 1e-9, err
-    assert rel_max(r.z, sim.z) < 1e-9
-    f_load = lugre.friction_force(r.v_load, DT, m)  # z from 0, as the load's
-    assert rel_max(f_load, sim.friction) < 1e-8
+    dt = 1e-3
+    t = np.arange(4000) * dt
+    w = 2 * np.pi * 3.0
+    v = 0.1 + 0.05 * np.sin(w * t)
+    x = 0.1 * t - 0.05 / w * (np.cos(w * t) - 1)
+    fine = lugre.load_coupling(x, v, dt, m, substeps=256).force
+    errs = [np.sqrt(np.mean((lugre.load_coupling(x, v, dt, m, substeps=s).force
+                             - fine)[500:] ** 2)) for s in (1, 2, 4, 8)]
+    ratios = np.array(errs[:-1]) / np.array(errs[1:])
+    np.testing.assert_allclose(ratios, 4.0, rtol=0.1, err_msg=str(errs))
 
 
 def test_coupling_force_against_a_fine_simulation():
@@ -187,20 +184,20 @@ def test_coupling_force_against_a_fine_simulation():
     ``K_F*i - mm*a_m``: with the current held over an interval, the forward difference
     of v is the mean motor acceleration over it, equal to the mean of the coupling
     force, which the trapezoid ``(F_s[k] + F_s[k+1])/2`` gives to O(dt^2 F'') (about
-    1e-4 of the force at the mode's 40 Hz). What remains is the first-order error of
-    the load step (h = 1e-4 s against the mode's 4 ms period and the bristles' fast
-    transients after reversals): measured 0.09 % relative rms (0.11 % without the
-    trapezoid), asserted below 0.3 %; the bristle state 0.12 % (asserted 0.5 %)."""
+    1e-4 of the force at the mode's 40 Hz). What remains is the load step's error at
+    the reversals (h = 1e-4 s against the bristles' fast transients): measured
+    0.0075 % relative rms (asserted below 0.03 %; 0.09 % for the semi-implicit Euler
+    step of the simulation); the bristle state 0.011 % (asserted 0.05 %)."""
     m = model()
     _, i, sim = _open_loop(m, 50)
     r = lugre.load_coupling(sim.x, sim.v, DT, m)
     fm = _measured_coupling_force(m, i, sim)
     fs_mean = 0.5 * (r.force[:-1] + r.force[1:])
     err = np.sqrt(np.mean((fs_mean - fm) ** 2)) / np.sqrt(np.mean(fm**2))
-    assert err < 3e-3, err
+    assert err < 3e-4, err
     # the load's bristle state and friction against the simulation's (at the load)
     zerr = np.sqrt(np.mean((r.z - sim.z) ** 2)) / np.sqrt(np.mean(sim.z**2))
-    assert zerr < 5e-3, zerr
+    assert zerr < 5e-4, zerr
     # the simulation does not record the load's position; the spring's stretch
     # x - x_load carries F_s less the damper's share (measured 0.5 %, asserted 2 %)
     k = RES["load_fraction"] * m.total_mass * (2 * np.pi * RES["frequency"]) ** 2
@@ -210,9 +207,10 @@ def test_coupling_force_against_a_fine_simulation():
 
 
 def test_error_shrinks_with_substeps():
-    """Against a 16-fold-substep run, a first-order error falls as ``1/s - 1/16``:
-    15/16 : 7/16 : 3/16 : 1/16 for s = 1, 2, 4, 8, ratios 2.14, 2.33, 3 (measured
-    2.14, 2.33, 3.00)."""
+    """Through reversals the friction is not smooth and the error is first order:
+    against a 16-fold-substep run it falls as ``1/s - 1/16``, 15/16 : 7/16 : 3/16 :
+    1/16 for s = 1, 2, 4, 8, ratios 2.14, 2.33, 3 (measured 2.15, 2.34, 3.00), from
+    6.9e-5 of the force's rms at one substep (asserted 2e-4)."""
     m = model()
     _, _, sim = _open_loop(m, 50)
     fine = lugre.load_coupling(sim.x, sim.v, DT, m, substeps=16).force
@@ -222,7 +220,7 @@ def test_error_shrinks_with_substeps():
         errs.append(np.sqrt(np.mean((f - fine) ** 2)))
     ratios = np.array(errs[:-1]) / np.array(errs[1:])
     np.testing.assert_allclose(ratios, [15 / 7, 7 / 3, 3.0], rtol=0.1, err_msg=str(errs))
-    assert errs[0] < 2e-3 * np.sqrt(np.mean(fine**2)), errs
+    assert errs[0] < 2e-4 * np.sqrt(np.mean(fine**2)), errs
 
 
 def test_steady_sliding_carries_the_friction_and_extra():

@@ -22,8 +22,9 @@ from .model import ModelLike, _as_model
 __all__ = ["COUPLING_SUBSTEPS", "MAX_FREQUENCIES", "InverseRecord", "parse_base_param",
            "position_sums"]
 
-#: Substeps multiplier of the load simulation behind a ``resonance``.
-COUPLING_SUBSTEPS = 4
+#: Substeps multiplier of the load simulation behind a ``resonance``
+#: (``COUPLING_SUBSTEPS`` in src/inverse/mod.rs).
+COUPLING_SUBSTEPS = 2
 
 #: Most frequencies in one call of :func:`position_sums` (``MAX_FREQUENCIES`` in
 #: ``src/inverse/spectrum.rs``).

@@ -1111,13 +1111,17 @@ def load_coupling(
         return CouplingResult(*(np.array(a, dtype=np.float64)
                                 for a in (out_f, out_x, out_v, out_z)))
     h = dtf / nsub
+    hh = 0.5 * h
     nf = float(nsub)
-    xl, vl = xa[0], va[0]
+    # xl at the substep's start, vl at the middle of the substep before, al its
+    # acceleration
+    xl, vl, al = xa[0], va[0], 0.0
     for i in range(n):
         x0, v0 = xa[i], va[i]
-        out_f[i] = kc * (x0 - xl) + c * (v0 - vl)
+        vt = vl + hh * al
+        out_f[i] = kc * (x0 - xl) + c * (v0 - vt)
         out_x[i] = xl
-        out_v[i] = vl
+        out_v[i] = vt
         out_z[i] = z
         if i + 1 == n:
             break
@@ -1130,14 +1134,15 @@ def load_coupling(
             else:
                 f = j / nf
                 xm, vm = x0 + dx * f, v0 + dv * f
-            fs = kc * (xm - xl) + c * (vm - vl)
+            vt = vl + hh * al
+            fs = kc * (xm - xl) + c * (vm - vt)
             if exponent is None:
-                g, ff, _ = _eval(p, z, vl, s)
+                g, ff, _ = _eval(p, z, vt, s)
             else:
-                g, ff, _ = _eval_shaped(p, z, vl, s, exponent)
+                g, ff, _ = _eval_shaped(p, z, vt, s, exponent)
             al = (fs - ff - fe) / ml
-            z = _advance_z(p, z, vl, g, h)
             vl += al * h
+            z = _advance_z(p, z, vl, g, h)
             xl += vl * h
         if not (math.isfinite(xl) and math.isfinite(vl) and math.isfinite(z)):
             raise DataError(

@@ -6,9 +6,12 @@
 //! `c`. The motor force that the model needs is `(1 - r)*M*a_m + F_s`, where
 //! `F_s = k*(x_m - x_l) + c*(v_m - v_l)` is the force the coupling passes to the load.
 //! The load's motion `x_l` is not measured: [`load_coupling`] simulates it, driven by the
-//! sampled motor position and velocity (linear interpolation between samples), with
-//! the same plant step as the servo simulation (exact bristle update, semi-implicit
-//! Euler). The algorithm is fixed in `docs/DESIGN.md` ("Load behind the coupling") and
+//! sampled motor position and velocity (linear interpolation between samples), by
+//! leapfrog: the velocity lives at the middle of each substep, its value at the start
+//! (for the damper and the friction) is predicted from the last acceleration, and the
+//! bristles take the exact update at the middle's velocity. Second order while the
+//! load slides; first order through reversals, where the friction is not smooth (the
+//! servo simulation's semi-implicit Euler step is first order everywhere). The algorithm is fixed in `docs/DESIGN.md` ("Load behind the coupling") and
 //! repeated step for step by `lugre.reference.load_coupling`.
 //!
 //! ```
@@ -367,14 +370,16 @@ fn run_width<S: Shape, const L: usize>(
     let h = dt / n_sub as f64;
     let nf = n_sub as f64;
     let fracs: Vec<f64> = (1..n_sub).map(|j| j as f64 / nf).collect();
+    let hh = 0.5 * h;
     let mut xl = [x[0]; L];
     let mut vl = [v[0]; L];
+    let mut al = [0.0; L];
     let mut z: [f64; L] = core::array::from_fn(|l| op[l].z0);
     let mut bad: [Option<usize>; L] = [None; L];
     for i in 0..n {
         let (x0, v0) = (x[i], v[i]);
         for l in 0..L {
-            force[l][i] = k[l] * (x0 - xl[l]) + c[l] * (v0 - vl[l]);
+            force[l][i] = k[l] * (x0 - xl[l]) + c[l] * (v0 - (vl[l] + hh * al[l]));
         }
         if i + 1 == n {
             break;
@@ -385,11 +390,12 @@ fn run_width<S: Shape, const L: usize>(
         // the substeps of every lane, as the `step` of `run_shaped`
         let mut sub = |xm: f64, vm: f64| {
             for l in 0..L {
-                let fs = k[l] * (xm - xl[l]) + c[l] * (vm - vl[l]);
-                let (g, ff) = fr[l].eval(shape, z[l], vl[l], s[l]);
-                let al = (fs - ff - fe[l]) / ml[l];
+                let vt = vl[l] + hh * al[l];
+                let fs = k[l] * (xm - xl[l]) + c[l] * (vm - vt);
+                let (g, ff) = fr[l].eval(shape, z[l], vt, s[l]);
+                al[l] = (fs - ff - fe[l]) / ml[l];
+                vl[l] += al[l] * h;
                 z[l] = fr[l].advance_z(z[l], vl[l], g, h);
-                vl[l] += al * h;
                 xl[l] += vl[l] * h;
             }
         };
@@ -422,6 +428,14 @@ fn diverged(i: usize) -> Error {
         "the load behind the coupling diverged after sample {i}: check the \
          motor motion and the model's resonance"
     ))
+}
+
+/// The state of the load between substeps (see [`run_shaped`]).
+struct Load {
+    xl: f64,
+    vl: f64,
+    al: f64,
+    z: f64,
 }
 
 /// The load's position, velocity and bristle state at the samples.
@@ -472,25 +486,34 @@ fn run_shaped<S: Shape>(
     let nf = n_sub as f64;
     // the interpolation fractions j/n of the substeps after the first
     let fracs: Vec<f64> = (1..n_sub).map(|j| j as f64 / nf).collect();
-    let mut xl = x[0];
-    let mut vl = v[0];
-    let mut z = opts.z0;
-    // one substep: the plant step of the load with the motor at (xm, vm)
-    let step = |xm: f64, vm: f64, s: f64, fe: f64, xl: &mut f64, vl: &mut f64, z: &mut f64| {
-        let fs = k * (xm - *xl) + c * (vm - *vl);
-        let (g, ff) = fr.eval(shape, *z, *vl, s);
-        let al = (fs - ff - fe) / ml;
-        *z = fr.advance_z(*z, *vl, g, h);
-        *vl += al * h;
-        *xl += *vl * h;
+    let hh = 0.5 * h;
+    // the load: position at the substep's start, velocity at the middle of the
+    // substep before, the acceleration of the substep before, bristle deflection
+    let mut st = Load {
+        xl: x[0],
+        vl: v[0],
+        al: 0.0,
+        z: opts.z0,
+    };
+    // one substep with the motor at (xm, vm): the velocity at its start predicted from
+    // the last acceleration, then leapfrog, the bristles at the middle's velocity
+    let step = |xm: f64, vm: f64, s: f64, fe: f64, st: &mut Load| {
+        let vt = st.vl + hh * st.al;
+        let fs = k * (xm - st.xl) + c * (vm - vt);
+        let (g, ff) = fr.eval(shape, st.z, vt, s);
+        st.al = (fs - ff - fe) / ml;
+        st.vl += st.al * h;
+        st.z = fr.advance_z(st.z, st.vl, g, h);
+        st.xl += st.vl * h;
     };
     for i in 0..n {
         let (x0, v0) = (x[i], v[i]);
-        force[i] = k * (x0 - xl) + c * (v0 - vl);
+        let vt = st.vl + hh * st.al;
+        force[i] = k * (x0 - st.xl) + c * (v0 - vt);
         if let Some((ox, ov, oz)) = load.as_mut() {
-            ox[i] = xl;
-            ov[i] = vl;
-            oz[i] = z;
+            ox[i] = st.xl;
+            ov[i] = vt;
+            oz[i] = st.z;
         }
         if i + 1 == n {
             break;
@@ -498,10 +521,11 @@ fn run_shaped<S: Shape>(
         let s = opts.scale.map_or(1.0, |a| a[i]);
         let fe = opts.extra.map_or(0.0, |a| a[i]);
         let (dx, dv) = (x[i + 1] - x0, v[i + 1] - v0);
-        step(x0, v0, s, fe, &mut xl, &mut vl, &mut z);
+        step(x0, v0, s, fe, &mut st);
         for &f in &fracs {
-            step(x0 + dx * f, v0 + dv * f, s, fe, &mut xl, &mut vl, &mut z);
+            step(x0 + dx * f, v0 + dv * f, s, fe, &mut st);
         }
+        let (xl, vl, z) = (st.xl, st.vl, st.z);
         if !(xl.is_finite() && vl.is_finite() && z.is_finite()) {
             return Err(diverged(i));
         }

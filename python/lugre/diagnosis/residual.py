@@ -452,7 +452,7 @@ def model_force(model: Model, sig: Signals) -> np.ndarray:
     With a ``resonance`` the encoder sees the motor, ``(1 - r)*m``, and the load ``r*m``
     carries the friction and the effect forces behind a spring-damper: the motor gives
     ``(1 - r)*m*a + F_s``, ``F_s`` the force the coupling passes to the load, simulated
-    along the measured motor motion (``lugre.load_coupling``, four substeps per sample).
+    along the measured motor motion (``lugre.load_coupling``, twice its automatic substeps).
     """
     return sig.kernel.model_force(model)
 
