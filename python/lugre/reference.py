@@ -650,11 +650,33 @@ class _Physics:
         s.vl += h / 6.0 * (k1[3] + 2.0 * k2[3] + 2.0 * k3[3] + k4[3])
         s.z += h / 6.0 * (k1[4] + 2.0 * k2[4] + 2.0 * k3[4] + k4[4])
 
-    def step_rk4(self, s: _State, ic: float, h: float, time: float) -> None:
-        fm = self.motor(s, ic, h)
-        if self.res is not None:
-            self.step_rk4_two_mass(s, fm, self.res, h, time)
-            return
+    def rk4_pieces(self, z: float, v: float, x: float, h: float, time: float) -> int:
+        """Pieces of an RK4 step keeping ``sigma0*|v|*h/g`` under the limit
+        (``Physics::rk4_pieces``)."""
+        if v == 0.0:
+            return 1
+        g, _, _ = self.friction(z, v, self.scale(x, time))
+        q = self.fr.sigma0 * abs(v) * h / g
+        if math.isnan(q) or q <= _RK4_BRISTLE_LIMIT:  # (NaN: the divergence check)
+            return 1
+        return int(min(_ceil_f(q / _RK4_BRISTLE_LIMIT), _RK4_MAX_PIECES))
+
+    def step_rk4(self, s: _State, ic: float, h_step: float, time: float) -> None:
+        """One plant step of RK4, the motor force held, in equal pieces where the
+        bristles would make it unstable (``Physics::step_rk4``)."""
+        fm = self.motor(s, ic, h_step)
+        x, v = (s.xl, s.vl) if self.res is not None else (s.x, s.v)
+        p = self.rk4_pieces(s.z, v, x, h_step, time)
+        h = h_step / float(p)
+        for j in range(p):
+            tj = time + float(j) * h
+            if self.res is not None:
+                self.step_rk4_two_mass(s, fm, self.res, h, tj)
+            else:
+                self.step_rk4_one_mass(s, fm, h, tj)
+
+    def step_rk4_one_mass(self, s: _State, fm: float, h: float, time: float) -> None:
+        """RK4 on ``(x, v, z)`` of the rigid axis, the motor force held."""
 
         def d(x: float, v: float, z: float, tm: float) -> tuple[float, float, float]:
             a, _, zdot = self.accel(fm, x, v, z, tm)
@@ -668,6 +690,12 @@ class _Physics:
         s.x += h / 6.0 * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0])
         s.v += h / 6.0 * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1])
         s.z += h / 6.0 * (k1[2] + 2.0 * k2[2] + 2.0 * k3[2] + k4[2])
+
+
+#: Largest ``sigma0*|v|*h/g`` of one RK4 step (``RK4_BRISTLE_LIMIT`` in sim.rs).
+_RK4_BRISTLE_LIMIT = 1.0
+#: Most pieces of one RK4 plant step (``RK4_MAX_PIECES``).
+_RK4_MAX_PIECES = 1e4
 
 
 def _ic_eff_peek(queue: deque[tuple[float, float]], current: float, time: float,
@@ -716,7 +744,9 @@ def simulate(
         is not used). Give exactly one of ``x_ref``, ``v_ref`` and ``current``.
     integrator : {"exact", "rk4"}, default "exact"
         ``"exact"``: exact bristle update with the velocity held and semi-implicit Euler
-        for x and v; ``"rk4"``: classic RK4 on (x, v, z).
+        for x and v; ``"rk4"``: classic RK4 on (x, v, z), a plant step split in
+        equal pieces where ``sigma0*|v|*h/g`` would exceed 1 at its start (beyond 2.78
+        the bristles make RK4 unstable).
     substeps : int, default 1
         Plant steps per control period (per sample interval in open loop).
     z0 : float, default 0.0
