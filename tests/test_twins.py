@@ -443,6 +443,16 @@ def test_rk4_keeps_up_with_fast_bristles(effects):
         assert err < tol, (f, err)
 
 
+@pytest.mark.parametrize("backend", BACKENDS, ids=["lugre", "reference"])
+def test_open_loop_divergence_names_the_current(backend):
+    """A current that overflows the force: the error is about the current and the
+    substeps, not about controller gains the open loop does not have."""
+    t = np.arange(0, 0.01, 1e-3)
+    with pytest.raises(lugre.DataError, match="check the current against the mass, or "
+                       "give more substeps"):
+        backend.simulate(lugre.Model.paper(), t, current=np.full(t.size, 1e307))
+
+
 def test_new_effects_with_current_loop_and_feedforward_twins():
     d = paper(effects=NEW_EFFECTS["resonance+cogging+deadband"]).to_dict()
     d["axis"]["current_loop"] = {"resistance": 1.2, "inductance": 0.01874,

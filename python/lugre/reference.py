@@ -967,9 +967,11 @@ def _simulate(
             step(s, ic_eff, h, tj)
         if not (math.isfinite(s.x) and math.isfinite(s.v) and math.isfinite(s.z)
                 and math.isfinite(s.xl) and math.isfinite(s.vl)):
+            hint = ("check the current against the mass, or give more substeps" if open_loop
+                    else "check the controller gains against the mass and the control rate, "
+                    "or give more substeps")
             raise DataError(
-                f"data: the simulation diverged at t = {_fmt_f64(time)}: check the controller gains "
-                "against the mass and the control rate"
+                f"data: the simulation diverged at t = {_fmt_f64(time)}: {hint}"
             )
         time = nxt
     return SimResult(ta.copy(), out_x, out_v, out_z, out_i, out_f, out_fm)

@@ -1008,8 +1008,14 @@ fn run<const EXTRAS: bool, const RK4: bool>(
             && s.z.is_finite()
             && (!EXTRAS || (s.xl.is_finite() && s.vl.is_finite())))
         {
+            let hint = if open_loop {
+                "check the current against the mass, or give more substeps"
+            } else {
+                "check the controller gains against the mass and the control rate, or give \
+                 more substeps"
+            };
             return Err(Error::Data(format!(
-                "the simulation diverged at t = {time}: check the controller gains against the mass and the control rate"
+                "the simulation diverged at t = {time}: {hint}"
             )));
         }
         time = next;
