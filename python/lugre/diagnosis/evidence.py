@@ -196,7 +196,8 @@ def base_report(model: Model, base: dict[str, float], free: list[str],
         out[n] = {"before": b0, "after": b1, "change": (b1 - b0) / b0 if b0 else 0.0,
                   "tolerance": rel, "unit": B.unit(n), "status": status}
     out["sigma1"]["presliding_test"] = {k: presliding[k] for k in
-                                        ("gain", "p", "positive", "free") if k in presliding}
+                                        ("gain", "min_gain", "p", "positive", "blocks", "free")
+                                        if k in presliding}
     return out
 
 
@@ -229,13 +230,20 @@ def base_notes(base: dict[str, dict[str, Any]], findings: list[Any]) -> list[str
     s1 = base["sigma1"]
     if "not determined" in s1["status"]:
         pt = s1.get("presliding_test", {})
+        blocks = (f"gains in {pt.get('positive', 0)} of {pt.get('blocks', 10)} stretches, "
+                  f"p = {pt.get('p', 1):.1g}")
+        if pt.get("gain", 0.0) <= pt.get("min_gain", 0.0):
+            why = (f"freeing them improves the held-out fit by too little to matter (a "
+                   f"score gain of {pt.get('gain', 0.0):.3g} against the "
+                   f"{pt.get('min_gain', 0.0):.3g} a finding needs; {blocks})")
+        else:
+            why = f"freeing them does not improve the held-out fit consistently ({blocks})"
         notes.append(
             "sigma0 and sigma1 (presliding stiffness and damping) are held at the model's "
-            f"values: freeing them does not improve the held-out fit consistently (gains in "
-            f"{pt.get('positive', 0)} of 10 stretches, p = {pt.get('p', 1):.1g}), so this "
-            "record does not determine them. To determine them: small back-and-forth moves "
-            "below the breakaway force (presliding, a few micrometres) or a small-amplitude "
-            "current sweep at standstill, logged at 1 kHz or faster.")
+            f"values: {why}, so this record does not determine them. To determine them: "
+            "small back-and-forth moves below the breakaway force (presliding, a few "
+            "micrometres) or a small-amplitude current sweep at standstill, logged at "
+            "1 kHz or faster.")
     bp, bn = base["positive.fc"]["after"], base["negative.fc"]["after"]
     if not any(f.effect == "offset" for f in findings) and abs(bp - bn) > 0.1 * (bp + bn) / 2:
         notes.append(
