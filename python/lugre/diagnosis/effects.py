@@ -85,6 +85,9 @@ class Candidate:
     #: also takes up part of the noise the residual holds: checked by SIMEX
     #: (:mod:`lugre.diagnosis.simex`)
     smooths_readings: bool = False
+    #: its nonlinear parameters are profiled again once later terms are in
+    #: (:func:`lugre.diagnosis.search.forward_select`)
+    reprofile: bool = False
 
     def choose(self, r: np.ndarray, ctx: Context) -> Any:
         """Pick the nonlinear parameter against the current residual ``r`` (filtered)."""
@@ -567,6 +570,7 @@ class Resonance(_Secant):
     signature = ("a compliant coupling: the load the encoder does not see swings against "
                  "the motor at the coupling's natural frequency")
     smooths_readings = True
+    reprofile = True
 
     #: damping ratios and load fractions of the search
     ZETAS = (0.03, 0.1, 0.3)
