@@ -613,8 +613,10 @@ def test_a_model_that_is_not_passive_is_warned_of_once_per_direction():
 
 
 @pytest.mark.parametrize("gain,p,expect", [
-    (3.0, 0.003, ("by too little to matter (a score gain of 3 against the 10 a finding "
-                  "needs; gains in 10 of 10 stretches, p = 0.003)")),
+    (3.0, 0.0003, ("by too little to matter (a score gain of 3 against the 10 a finding "
+                   "needs; gains in 10 of 10 stretches, p = 0.0003)")),
+    (3.0, 0.3, ("does not improve the held-out fit consistently (gains in 6 of 10 "
+                "stretches, p = 0.3)")),
     (40.0, 0.2, ("does not improve the held-out fit consistently (gains in 6 of 10 "
                  "stretches, p = 0.2)")),
 ])
@@ -629,8 +631,8 @@ def test_presliding_note_gives_the_reason_it_is_held(gain, p, expect):
 
     base = {n: entry(28.0) for n in ("positive.fc", "negative.fc")}
     base["sigma1"] = dict(entry(31.6), status="not determined by this record (held)",
-                          presliding_test={"gain": gain, "min_gain": 10.0, "p": p,
-                                           "positive": 10 if p < 0.01 else 6,
+                          presliding_test={"gain": gain, "min_gain": 10.0, "alpha": 1e-3,
+                                           "p": p, "positive": 10 if p < 1e-3 else 6,
                                            "blocks": 10, "free": False})
     notes = [n for n in base_notes(base, []) if n.startswith("sigma0 and sigma1")]
     assert len(notes) == 1 and expect in notes[0], notes

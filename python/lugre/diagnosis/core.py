@@ -348,7 +348,7 @@ def _diagnose(
         # mismatch at the reversals there, which sigma1 would absorb: -100 % on clean
         # records)
         pt = compare(ev_h, ev_f, s2)
-        pt["min_gain"] = min_gain
+        pt["min_gain"], pt["alpha"] = min_gain, alpha
         pt["free"] = bool(len(held) < len(names_all)
                           and accept(pt, alpha=alpha, min_gain=min_gain)[0]
                           and pt["p"] < alpha)

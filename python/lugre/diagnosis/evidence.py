@@ -196,7 +196,8 @@ def base_report(model: Model, base: dict[str, float], free: list[str],
         out[n] = {"before": b0, "after": b1, "change": (b1 - b0) / b0 if b0 else 0.0,
                   "tolerance": rel, "unit": B.unit(n), "status": status}
     out["sigma1"]["presliding_test"] = {k: presliding[k] for k in
-                                        ("gain", "min_gain", "p", "positive", "blocks", "free")
+                                        ("gain", "min_gain", "alpha", "p", "positive",
+                                         "blocks", "free")
                                         if k in presliding}
     return out
 
@@ -232,7 +233,8 @@ def base_notes(base: dict[str, dict[str, Any]], findings: list[Any]) -> list[str
         pt = s1.get("presliding_test", {})
         blocks = (f"gains in {pt.get('positive', 0)} of {pt.get('blocks', 10)} stretches, "
                   f"p = {pt.get('p', 1):.1g}")
-        if pt.get("gain", 0.0) <= pt.get("min_gain", 0.0):
+        if (pt.get("p", 1.0) < pt.get("alpha", 0.0)
+                and pt.get("gain", 0.0) <= pt.get("min_gain", 0.0)):
             why = (f"freeing them improves the held-out fit by too little to matter (a "
                    f"score gain of {pt.get('gain', 0.0):.3g} against the "
                    f"{pt.get('min_gain', 0.0):.3g} a finding needs; {blocks})")
