@@ -375,7 +375,8 @@ class Lag(Candidate):
     (:mod:`lugre.diagnosis.timing`)."""
 
     effect = "delay"
-    signature = "a force proportional to the rate of change of the motor force (a lag)"
+    signature = ("the motor force arrives late: the residual follows the rate of change of "
+                 "the motor force")
 
     def columns(self, h: Any, ctx: Context) -> np.ndarray:
         return ctx.sig.dfm[:, None].copy()
