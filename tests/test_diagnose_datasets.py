@@ -87,6 +87,8 @@ def test_clean_record_holds_the_presliding_parameters():
     assert abs(dg.base["sigma1"]["change"]) < 0.1
     assert all(abs(b["change"]) < 2 * b["tolerance"] for b in dg.base.values())
     hidden = {h["effect"]: h for h in dg.could_not_reveal}
-    assert {"offset", "mass", "drag", "deadband", "cogging"} <= set(hidden)
+    assert {"offset", "mass", "drag", "deadband", "cogging", "resonance"} <= set(hidden)
     assert 0 < hidden["mass"]["smallest"] < 1.0  # kg: a 1 kg payload would be seen
+    # the public resonance (75 % of the mass at 22 Hz) would be seen on this record
+    assert 0 < hidden["resonance"]["smallest"] < 0.75, hidden["resonance"]
     assert dg.verdict.startswith("Nothing found")

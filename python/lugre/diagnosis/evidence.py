@@ -592,9 +592,14 @@ def _nonlinear_hidden(c: Any, ctx: Any, size: Any) -> dict[str, Any] | None:
         fs = sorted({h[0] for h in g})
         pts = [(f, 0.05, 0.5) for f in fs]
         cols = c.columns_many(pts, ctx) or [c.columns(h, ctx) for h in pts]  # (in parallel)
-        hidden = [f for f, X in zip(fs, cols) if size(X[:, 0]) > 1.0]
+        sizes = [size(X[:, 0]) for X in cols]  # in units of the half-mass load's force
+        hidden = [f for f, sz in zip(fs, sizes) if sz > 1.0]
         if not hidden:
-            return None
+            # the load's force grows about in proportion to its share of the mass
+            b = 0.5 * max(sizes)
+            return _hide(c.effect, b, "load fraction",
+                         f"a resonance with under {100 * b:.2g} % of the mass behind its "
+                         f"coupling (lightly damped, at {fs[0]:.3g} to {fs[-1]:.3g} Hz)")
         return _hide(c.effect, 0.5, "load fraction",
                      f"a resonance with half the mass on the coupling at {hidden[0]:.3g} to "
                      f"{hidden[-1]:.3g} Hz",
