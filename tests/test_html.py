@@ -199,3 +199,14 @@ def test_long_profiles_are_summarised_in_units():
     text = text_of(diagnosis_page(report))
     assert "25 values, −100 to 200 mm" in text
     assert "largest change ×1.32 at −25 mm" in text
+
+
+def test_a_small_share_is_not_written_as_zero():
+    """A finding that explains 0.4 % of the residual reads "under 0.5 %", not "0 %"."""
+    from lugre import units as U
+
+    assert U.percent(0.004) == "under 0.5 %"
+    assert U.percent(0.0004, 1) == "under 0.05 %"
+    assert U.percent(0.006) == "1 %"
+    assert U.percent(0.0) == "0 %"
+    assert U.percent(0.5) == "50 %"

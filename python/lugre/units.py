@@ -115,7 +115,11 @@ def fmt_range(lo: Any, hi: Any, unit: tuple[str, float] | str = ("", 1.0),
 
 
 def percent(share: float, digits: int = 0) -> str:
-    """A share as a percentage."""
+    """A share as a percentage (a positive share that would round to zero: "under" the
+    last digit's half)."""
+    half = 0.5 * 10.0 ** -digits
+    if 0.0 < 100 * share < half:
+        return f"under {half:.{digits + 1}f} %"
     return f"{100 * share:.{digits}f} %"
 
 

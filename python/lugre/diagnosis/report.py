@@ -204,7 +204,7 @@ class Diagnosis:
             wh = ", ".join(f"{a} {U.fmt_range(v[0], v[1], U.WHERE_UNITS.get(a, ('', 1.0)))}"
                            if isinstance(v, (list, tuple)) and len(v) == 2 else f"{a} {_fmt(v)}"
                            for a, v in f.where.items() if v is not None)
-            line = (f"{k}. {f.effect}{' (' + ps + ')' if ps else ''} explains {100 * f.explained:.0f} % of "
+            line = (f"{k}. {f.effect}{' (' + ps + ')' if ps else ''} explains {U.percent(f.explained)} of "
                     f"the residual{'; lives at ' + wh if wh else ''}.")
             lines.append(line.replace("\u2212", "-"))
             lines.append(f"   {plain_text(f.evidence)}")
