@@ -186,7 +186,7 @@ def test_coupling_force_against_a_fine_simulation():
     force, which the trapezoid ``(F_s[k] + F_s[k+1])/2`` gives to O(dt^2 F'') (about
     1e-4 of the force at the mode's 40 Hz). What remains is the load step's error at
     the reversals (h = 1e-4 s against the bristles' fast transients): measured
-    0.0075 % relative rms (asserted below 0.03 %; 0.09 % for the semi-implicit Euler
+    0.0074 % relative rms (asserted below 0.03 %; 0.09 % for the semi-implicit Euler
     step of the simulation); the bristle state 0.011 % (asserted 0.05 %)."""
     m = model()
     _, i, sim = _open_loop(m, 50)
@@ -209,8 +209,8 @@ def test_coupling_force_against_a_fine_simulation():
 def test_error_shrinks_with_substeps():
     """Through reversals the friction is not smooth and the error is first order:
     against a 16-fold-substep run it falls as ``1/s - 1/16``, 15/16 : 7/16 : 3/16 :
-    1/16 for s = 1, 2, 4, 8, ratios 2.14, 2.33, 3 (measured 2.15, 2.34, 3.00), from
-    6.9e-5 of the force's rms at one substep (asserted 2e-4)."""
+    1/16 for s = 1, 2, 4, 8, ratios 2.14, 2.33, 3 (measured 2.13, 2.33, 2.99), from
+    6.7e-5 of the force's rms at one substep (asserted 2e-4)."""
     m = model()
     _, _, sim = _open_loop(m, 50)
     fine = lugre.load_coupling(sim.x, sim.v, DT, m, substeps=16).force

@@ -127,8 +127,8 @@ def load_coupling(
     the sampled motor position and velocity, interpolated linearly between samples, in
     ``substeps*max(1, ceil(4*w*dt), ceil(d*dt))`` substeps per interval with
     ``w = sqrt((k + sigma0)/(r*M))`` and ``d = (c + sigma1 + max(sigma2))/(r*M)``
-    (leapfrog with the velocity at each substep's start predicted from the last
-    acceleration, exact bristle update at the midpoint velocity; ``docs/DESIGN.md``). With ``a_m`` the motor's acceleration, the model's motor force
+    (leapfrog, the velocities at each substep's start and middle predicted from the
+    last acceleration, exact bristle update; ``docs/DESIGN.md``). With ``a_m`` the motor's acceleration, the model's motor force
     is ``(1 - r)*M*a_m + force``. Runs in the Rust core; the parameters and results are
     those of :func:`lugre.reference.load_coupling`.
 

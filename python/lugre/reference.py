@@ -1167,14 +1167,15 @@ def load_coupling(
                 f = j / nf
                 xm, vm = x0 + dx * f, v0 + dv * f
             vt = vl + hh * al
+            vz = vl + h * al
             fs = kc * (xm - xl) + c * (vm - vt)
             if exponent is None:
                 g, ff, _ = _eval(p, z, vt, s)
             else:
                 g, ff, _ = _eval_shaped(p, z, vt, s, exponent)
             al = (fs - ff - fe) / ml
+            z = _advance_z(p, z, vz, g, h)
             vl += al * h
-            z = _advance_z(p, z, vl, g, h)
             xl += vl * h
         if not (math.isfinite(xl) and math.isfinite(vl) and math.isfinite(z)):
             raise DataError(

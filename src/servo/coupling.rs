@@ -7,12 +7,13 @@
 //! `F_s = k*(x_m - x_l) + c*(v_m - v_l)` is the force the coupling passes to the load.
 //! The load's motion `x_l` is not measured: [`load_coupling`] simulates it, driven by the
 //! sampled motor position and velocity (linear interpolation between samples), by
-//! leapfrog: the velocity lives at the middle of each substep, its value at the start
-//! (for the damper and the friction) is predicted from the last acceleration, and the
-//! bristles take the exact update at the middle's velocity. Second order while the
-//! load slides; first order through reversals, where the friction is not smooth (the
-//! servo simulation's semi-implicit Euler step is first order everywhere). The algorithm is fixed in `docs/DESIGN.md` ("Load behind the coupling") and
-//! repeated step for step by `lugre.reference.load_coupling`.
+//! leapfrog: the velocity lives at the middle of each substep, its values at the start
+//! (for the damper and the friction) and at the middle (for the bristles' exact update)
+//! are predicted from the last acceleration. Second order while the load slides; first
+//! order through reversals, where the friction is not smooth (the servo simulation's
+//! semi-implicit Euler step is first order everywhere). The algorithm is fixed in
+//! `docs/DESIGN.md` ("Load behind the coupling") and repeated step for step by
+//! `lugre.reference.load_coupling`.
 //!
 //! ```
 //! use lugre::servo::{load_coupling, CouplingOptions, Model};
@@ -391,11 +392,12 @@ fn run_width<S: Shape, const L: usize>(
         let mut sub = |xm: f64, vm: f64| {
             for l in 0..L {
                 let vt = vl[l] + hh * al[l];
+                let vz = vl[l] + h * al[l];
                 let fs = k[l] * (xm - xl[l]) + c[l] * (vm - vt);
                 let (g, ff) = fr[l].eval(shape, z[l], vt, s[l]);
                 al[l] = (fs - ff - fe[l]) / ml[l];
+                z[l] = fr[l].advance_z(z[l], vz, g, h);
                 vl[l] += al[l] * h;
-                z[l] = fr[l].advance_z(z[l], vl[l], g, h);
                 xl[l] += vl[l] * h;
             }
         };
@@ -495,15 +497,17 @@ fn run_shaped<S: Shape>(
         al: 0.0,
         z: opts.z0,
     };
-    // one substep with the motor at (xm, vm): the velocity at its start predicted from
-    // the last acceleration, then leapfrog, the bristles at the middle's velocity
+    // one substep with the motor at (xm, vm): the velocities at its start and middle
+    // predicted from the last acceleration (the bristles' update then does not wait for
+    // this substep's acceleration), then leapfrog
     let step = |xm: f64, vm: f64, s: f64, fe: f64, st: &mut Load| {
         let vt = st.vl + hh * st.al;
+        let vz = st.vl + h * st.al;
         let fs = k * (xm - st.xl) + c * (vm - vt);
         let (g, ff) = fr.eval(shape, st.z, vt, s);
         st.al = (fs - ff - fe) / ml;
+        st.z = fr.advance_z(st.z, vz, g, h);
         st.vl += st.al * h;
-        st.z = fr.advance_z(st.z, st.vl, g, h);
         st.xl += st.vl * h;
     };
     for i in 0..n {
