@@ -683,6 +683,23 @@ mod tests {
     }"#;
 
     #[test]
+    fn numbers_are_read_to_the_last_bit() {
+        // serde_json's default float parser is off by one unit in the last place on
+        // these (99380.907687806, 0.01008508328349048): the twins then drift apart
+        let json = PAPER.replace("1e5", "99380.90768780599").replacen(
+            r#""vs": 0.01}"#,
+            r#""vs": 0.010085083283490481}"#,
+            1,
+        );
+        let m = Model::from_json(&json).unwrap();
+        assert_eq!(m.friction.sigma0.to_bits(), 99380.90768780599f64.to_bits());
+        assert_eq!(
+            m.friction.positive.vs.to_bits(),
+            0.010085083283490481f64.to_bits()
+        );
+    }
+
+    #[test]
     fn parses_contract_example() {
         let m = Model::from_json(PAPER).unwrap();
         assert_eq!(m, Model::paper());
