@@ -362,25 +362,17 @@ fn run_width<S: Shape, const L: usize>(
         return force.into_iter().map(Ok).collect();
     }
     let (x, v) = (&x[..n], &v[..n]);
-    let cp: [&Coupling; L] = core::array::from_fn(|l| lanes[l].0);
     let op: [&CouplingOptions; L] = core::array::from_fn(|l| lanes[l].1);
-    let fr: [Fast; L] = core::array::from_fn(|l| Fast::new(&cp[l].friction, cp[l].exponent));
-    let k: [f64; L] = core::array::from_fn(|l| cp[l].k);
-    let c: [f64; L] = core::array::from_fn(|l| cp[l].c);
-    let ml: [f64; L] = core::array::from_fn(|l| cp[l].ml);
+    let mut ld: [Load; L] = core::array::from_fn(|l| Load::new(lanes[l].0, op[l].z0, x[0], v[0]));
     let h = dt / n_sub as f64;
     let nf = n_sub as f64;
     let fracs: Vec<f64> = (1..n_sub).map(|j| j as f64 / nf).collect();
     let hh = 0.5 * h;
-    let mut xl = [x[0]; L];
-    let mut vl = [v[0]; L];
-    let mut al = [0.0; L];
-    let mut z: [f64; L] = core::array::from_fn(|l| op[l].z0);
     let mut bad: [Option<usize>; L] = [None; L];
     for i in 0..n {
         let (x0, v0) = (x[i], v[i]);
         for l in 0..L {
-            force[l][i] = k[l] * (x0 - xl[l]) + c[l] * (v0 - (vl[l] + hh * al[l]));
+            force[l][i] = ld[l].coupling(x0, v0, hh);
         }
         if i + 1 == n {
             break;
@@ -388,17 +380,10 @@ fn run_width<S: Shape, const L: usize>(
         let s: [f64; L] = core::array::from_fn(|l| op[l].scale.map_or(1.0, |a| a[i]));
         let fe: [f64; L] = core::array::from_fn(|l| op[l].extra.map_or(0.0, |a| a[i]));
         let (dx, dv) = (x[i + 1] - x0, v[i + 1] - v0);
-        // the substeps of every lane, as the `step` of `run_shaped`
+        // the substeps of every lane, side by side
         let mut sub = |xm: f64, vm: f64| {
             for l in 0..L {
-                let vt = vl[l] + hh * al[l];
-                let vz = vl[l] + h * al[l];
-                let fs = k[l] * (xm - xl[l]) + c[l] * (vm - vt);
-                let (g, ff) = fr[l].eval(shape, z[l], vt, s[l]);
-                al[l] = (fs - ff - fe[l]) / ml[l];
-                z[l] = fr[l].advance_z(z[l], vz, g, h);
-                vl[l] += al[l] * h;
-                xl[l] += vl[l] * h;
+                ld[l].step(shape, xm, vm, s[l], fe[l], h, hh);
             }
         };
         sub(x0, v0);
@@ -406,7 +391,7 @@ fn run_width<S: Shape, const L: usize>(
             sub(x0 + dx * f, v0 + dv * f);
         }
         for l in 0..L {
-            if bad[l].is_none() && !(xl[l].is_finite() && vl[l].is_finite() && z[l].is_finite()) {
+            if bad[l].is_none() && !ld[l].is_finite() {
                 bad[l] = Some(i);
             }
         }
@@ -432,12 +417,68 @@ fn diverged(i: usize) -> Error {
     ))
 }
 
-/// The state of the load between substeps (see [`run_shaped`]).
+/// One load simulation: its coupling and friction, and its state between substeps
+/// (position at a substep's start, velocity at the middle of the substep before, that
+/// substep's acceleration, bristle deflection). The one step of [`run_shaped`] and of
+/// the interleaved lanes of [`run_width`].
 struct Load {
+    k: f64,
+    c: f64,
+    ml: f64,
+    fr: Fast,
     xl: f64,
     vl: f64,
     al: f64,
     z: f64,
+}
+
+impl Load {
+    /// At rest against the motor's first sample `(x0, v0)`, bristles at `z0`.
+    fn new(cp: &Coupling, z0: f64, x0: f64, v0: f64) -> Load {
+        Load {
+            k: cp.k,
+            c: cp.c,
+            ml: cp.ml,
+            fr: Fast::new(&cp.friction, cp.exponent),
+            xl: x0,
+            vl: v0,
+            al: 0.0,
+            z: z0,
+        }
+    }
+
+    /// The velocity at a substep's start, predicted from the last acceleration.
+    #[inline(always)]
+    fn v_start(&self, hh: f64) -> f64 {
+        self.vl + hh * self.al
+    }
+
+    /// The force the coupling passes to the load with the motor at `(xm, vm)`.
+    #[inline(always)]
+    fn coupling(&self, xm: f64, vm: f64, hh: f64) -> f64 {
+        self.k * (xm - self.xl) + self.c * (vm - self.v_start(hh))
+    }
+
+    /// One substep of length `h` (`hh = h/2`) with the motor at `(xm, vm)`: the
+    /// velocities at its start and middle predicted from the last acceleration (the
+    /// bristles' update then does not wait for this substep's acceleration), then
+    /// leapfrog.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn step<S: Shape>(&mut self, shape: S, xm: f64, vm: f64, s: f64, fe: f64, h: f64, hh: f64) {
+        let vt = self.v_start(hh);
+        let vz = self.vl + h * self.al;
+        let fs = self.k * (xm - self.xl) + self.c * (vm - vt);
+        let (g, ff) = self.fr.eval(shape, self.z, vt, s);
+        self.al = (fs - ff - fe) / self.ml;
+        self.z = self.fr.advance_z(self.z, vz, g, h);
+        self.vl += self.al * h;
+        self.xl += self.vl * h;
+    }
+
+    fn is_finite(&self) -> bool {
+        self.xl.is_finite() && self.vl.is_finite() && self.z.is_finite()
+    }
 }
 
 /// The load's position, velocity and bristle state at the samples.
@@ -456,10 +497,9 @@ fn run(
     force: &mut [f64],
     load: LoadOut<'_>,
 ) -> Result<()> {
-    let fast = Fast::new(&cp.friction, cp.exponent);
     match cp.exponent {
-        None => run_shaped(cp, &fast, Square, x, v, dt, opts, n_sub, force, load),
-        Some(e) => run_shaped(cp, &fast, Power(e), x, v, dt, opts, n_sub, force, load),
+        None => run_shaped(cp, Square, x, v, dt, opts, n_sub, force, load),
+        Some(e) => run_shaped(cp, Power(e), x, v, dt, opts, n_sub, force, load),
     }
 }
 
@@ -468,7 +508,6 @@ fn run(
 #[inline(always)]
 fn run_shaped<S: Shape>(
     cp: &Coupling,
-    fr: &Fast,
     shape: S,
     x: &[f64],
     v: &[f64],
@@ -483,41 +522,19 @@ fn run_shaped<S: Shape>(
         return Ok(());
     }
     let (x, v, force) = (&x[..n], &v[..n], &mut force[..n]);
-    let (k, c, ml) = (cp.k, cp.c, cp.ml);
     let h = dt / n_sub as f64;
     let nf = n_sub as f64;
     // the interpolation fractions j/n of the substeps after the first
     let fracs: Vec<f64> = (1..n_sub).map(|j| j as f64 / nf).collect();
     let hh = 0.5 * h;
-    // the load: position at the substep's start, velocity at the middle of the
-    // substep before, the acceleration of the substep before, bristle deflection
-    let mut st = Load {
-        xl: x[0],
-        vl: v[0],
-        al: 0.0,
-        z: opts.z0,
-    };
-    // one substep with the motor at (xm, vm): the velocities at its start and middle
-    // predicted from the last acceleration (the bristles' update then does not wait for
-    // this substep's acceleration), then leapfrog
-    let step = |xm: f64, vm: f64, s: f64, fe: f64, st: &mut Load| {
-        let vt = st.vl + hh * st.al;
-        let vz = st.vl + h * st.al;
-        let fs = k * (xm - st.xl) + c * (vm - vt);
-        let (g, ff) = fr.eval(shape, st.z, vt, s);
-        st.al = (fs - ff - fe) / ml;
-        st.z = fr.advance_z(st.z, vz, g, h);
-        st.vl += st.al * h;
-        st.xl += st.vl * h;
-    };
+    let mut ld = Load::new(cp, opts.z0, x[0], v[0]);
     for i in 0..n {
         let (x0, v0) = (x[i], v[i]);
-        let vt = st.vl + hh * st.al;
-        force[i] = k * (x0 - st.xl) + c * (v0 - vt);
+        force[i] = ld.coupling(x0, v0, hh);
         if let Some((ox, ov, oz)) = load.as_mut() {
-            ox[i] = st.xl;
-            ov[i] = vt;
-            oz[i] = st.z;
+            ox[i] = ld.xl;
+            ov[i] = ld.v_start(hh);
+            oz[i] = ld.z;
         }
         if i + 1 == n {
             break;
@@ -525,12 +542,11 @@ fn run_shaped<S: Shape>(
         let s = opts.scale.map_or(1.0, |a| a[i]);
         let fe = opts.extra.map_or(0.0, |a| a[i]);
         let (dx, dv) = (x[i + 1] - x0, v[i + 1] - v0);
-        step(x0, v0, s, fe, &mut st);
+        ld.step(shape, x0, v0, s, fe, h, hh);
         for &f in &fracs {
-            step(x0 + dx * f, v0 + dv * f, s, fe, &mut st);
+            ld.step(shape, x0 + dx * f, v0 + dv * f, s, fe, h, hh);
         }
-        let (xl, vl, z) = (st.xl, st.vl, st.z);
-        if !(xl.is_finite() && vl.is_finite() && z.is_finite()) {
+        if !ld.is_finite() {
             return Err(diverged(i));
         }
     }
