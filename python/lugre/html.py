@@ -202,8 +202,15 @@ def _param_rows(effect: str, params: dict[str, Any], unc: dict[str, Any]) -> lis
             value = _list_summary(name, list(val), unit, params)
         else:
             value = U.fmt(val, unit) if isinstance(val, (int, float, list, tuple)) else str(val)
-        rows.append([escape(name.replace("_", " ")), escape(value), escape(interval)])
+        label = _TIMING_LABELS.get((effect, name), name.replace("_", " "))
+        rows.append([escape(label), escape(value), escape(interval)])
     return rows
+
+
+# a timing finding carries both of its readings (lugre.diagnosis.timing.timing_parameters)
+_TIMING_LABELS = {("delay", "seconds"): "effective delay",
+                  ("delay", "bandwidth"): "or, as a current lag, its bandwidth",
+                  ("current_lag", "seconds"): "effective delay"}
 
 
 def _where_text(where: dict[str, Any] | None) -> str:

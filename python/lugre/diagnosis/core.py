@@ -698,8 +698,13 @@ def _diagnose(
                                                   sig, min_gain)
             if alt_off is not None:
                 alternatives.setdefault(k, []).append(alt_off)
+        params = {a: v for a, v in e0.items() if a != "effect"}
+        if t.effect == "delay":
+            from .timing import timing_parameters
+
+            params = timing_parameters(e0, alternatives.get(k, []))
         findings.append(Finding(
-            effect=e0["effect"], parameters={a: v for a, v in e0.items() if a != "effect"},
+            effect=e0["effect"], parameters=params,
             where=t.cand.where(t.h, betas[k], ctx), explained=expl,
             evidence=V.evidence(t, lg, blocks, extra), alternatives=alternatives.get(k, []),
             uncertainty=unc))

@@ -649,6 +649,10 @@ def _params(f: Any) -> str:
              "gain": "", "time_constant": "s", "frequency": "Hz", "damping_ratio": "",
              "load_fraction": "", "current": "A", "coefficient": "N s^2/m^2",
              "exponent": ""}
+    if f.effect in ("delay", "current_lag"):
+        from .timing import timing_words
+
+        return timing_words(f.effect, f.parameters)
     parts = []
     for k, v in f.parameters.items():
         if isinstance(v, (int, float)):

@@ -201,6 +201,10 @@ class Diagnosis:
                 f"{a} {U.fmt(v, U.unit_of(f.effect, a))}" for a, v in f.parameters.items()
                 if a not in ("positions", "scale")
             )
+            if f.effect in ("delay", "current_lag"):
+                from .timing import timing_words
+
+                ps = timing_words(f.effect, f.parameters)
             wh = ", ".join(f"{a} {U.fmt_range(v[0], v[1], U.WHERE_UNITS.get(a, ('', 1.0)))}"
                            if isinstance(v, (list, tuple)) and len(v) == 2 else f"{a} {_fmt(v)}"
                            for a, v in f.where.items() if v is not None)

@@ -23,7 +23,8 @@ from .evidence import EXPERIMENT
 from .refit import refine
 from .search import Term, told_apart
 
-__all__ = ["choose_timing", "effective_delay", "smoothing_gain"]
+__all__ = ["choose_timing", "effective_delay", "smoothing_gain", "timing_parameters",
+           "timing_words"]
 
 
 def effective_delay(effect: dict[str, Any]) -> float:
@@ -31,6 +32,38 @@ def effective_delay(effect: dict[str, Any]) -> float:
     if effect["effect"] == "delay":
         return float(effect["seconds"])
     return 1.0 / (2.0 * math.pi * float(effect["bandwidth"]))
+
+
+def timing_parameters(effect: dict[str, Any],
+                      alternatives: list[dict[str, Any]]) -> dict[str, float]:
+    """A timing finding's parameters in both of its readings.
+
+    ``seconds`` is always the effective delay (for a lag, its mean delay); a lag's
+    ``bandwidth`` is given when the finding is a lag, or a delay whose lag reading the
+    record does not rule out (the lag is then among the alternatives, and its fitted
+    bandwidth is the one given). The augmented model holds the named form only.
+    """
+    out = {"seconds": effective_delay(effect)}
+    if effect["effect"] == "current_lag":
+        out["bandwidth"] = float(effect["bandwidth"])
+    else:
+        lag = next((a for a in alternatives if a.get("effect") == "current_lag"), None)
+        if lag is not None:
+            out["bandwidth"] = float(lag["parameters"]["bandwidth"])
+    return out
+
+
+def timing_words(effect: str, parameters: dict[str, Any]) -> str:
+    """A timing finding's parameters in words: "effective delay 1.3 ms, or a current lag
+    of 125 Hz" for a delay the record does not tell from a lag."""
+    sec = parameters.get("seconds")
+    bw = parameters.get("bandwidth")
+    d = f"effective delay {sec * 1e3:.3g} ms" if isinstance(sec, (int, float)) else ""
+    if effect == "current_lag" and isinstance(bw, (int, float)):
+        return f"bandwidth {bw:.3g} Hz" + (f", {d}" if d else "")
+    if isinstance(bw, (int, float)):
+        return d + f", or a current lag of {bw:.3g} Hz"
+    return d
 
 
 def smoothing_gain(sig: R.Signals, bandwidth: float, n: int, s2: float) -> float:
