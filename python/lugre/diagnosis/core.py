@@ -470,6 +470,7 @@ def _diagnose(
             scorer, J, names, tol = base_set(presliding["free"])
             ev = scorer.evaluate(terms)
     ev_sel = ev
+    terms_sel = list(terms)  # as the search's scorer reads them (for what it could miss)
     intervals = _jackknife_intervals(terms, ev_sel, J.shape[1], ctx)
 
     # 4. refit: the exact forms jointly with the base; timing told apart by its forms
@@ -764,9 +765,11 @@ def _diagnose(
             + " (consistent on held-out stretches), but with it the rest stays over "
             f"{PARTIAL_REST:g} times the noise floor and less than 90 % is explained: "
             "physics outside the vocabulary is likelier than that name.")
+    kept = {t.effect for t in terms}
     hidden = V.could_not_reveal(scorer, ctx, E.candidates(),
                                 [t.effect for t in terms if not t.minor],
-                                min_gain)
+                                min_gain, terms=[t for t in terms_sel if t.effect in kept],
+                                alpha=alpha, noise_rms=noise["rms"], min_force=min_force)
     ks0, pk0 = position_spectrum(r0, sig)
     _, pk = position_spectrum(r1, sig)
     data = {"t": sig.t, "x": sig.x, "v": sig.vf, "force": sig.fm_f, "before": r0, "after": r1,

@@ -476,25 +476,34 @@ def unexplained(r: np.ndarray, sig: R.Signals, floor: float, where: dict[str, An
 
 
 def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str],
-                     min_gain: float) -> list[dict[str, Any]]:
+                     min_gain: float, *, terms: list[Term] | None = None,
+                     alpha: float = 1e-3, noise_rms: float = 0.0, min_force: float = 0.0,
+                     min_effect: float = 0.2) -> list[dict[str, Any]]:
     """Per effect of the vocabulary not found: the smallest size this record would have
-    revealed, from the held-out scale of the search.
+    revealed, by the search's own test.
 
-    An effect of size ``b`` with column ``X`` (per unit size) lowers the held-out score by
-    about ``b^2*|X_perp|^2/s2`` (``X_perp``: what the friction levels cannot absorb);
-    the search needs about ``min_gain + 20`` to accept it consistently, so sizes under
-    ``sqrt((min_gain + 20)*s2/|X_perp|^2)`` pass unseen.
+    An effect of size ``b`` with column ``X`` (per unit size) is added to this record's
+    residual, and the held-out blocks judge it as the search would (:func:`revealed_size`,
+    with ``terms``, the terms found, in both fits): the size given is the smallest from
+    which it passes for either sign. The noise, the record's own unevenness (an effect
+    that lives in a few blocks passes the consistency test late) and the friction levels'
+    share of the effect all count, as they do in the search. So does its practical
+    size: a finding's force must reach ``min_effect`` times the noise floor
+    ``noise_rms`` and (but for timing) ``min_force``, or it is at most a minor
+    correction.
     """
-    need = min_gain + 20.0
-    J = scorer.J[scorer.idx]
-    Q = np.linalg.qr(J)[0] if J.shape[1] else np.zeros((J.shape[0], 0))
+    found_terms = list(terms or [])
     sig = ctx.sig
 
+    def sizes(Xs: list[np.ndarray]) -> np.ndarray:
+        # (a minor correction of the same kind, kept in the fit, is part of the effect)
+        rest = [t for t in found_terms if t.cand is None or t.effect != e]
+        floor = max(min_effect * noise_rms, 0.0 if e == "delay" else min_force)
+        return revealed_sizes(scorer, rest, Xs, alpha=alpha, min_gain=min_gain,
+                              min_rms=floor)
+
     def size(X: np.ndarray) -> float:
-        x = X[scorer.idx]
-        xp = x - Q @ (Q.T @ x)
-        e = float(xp @ xp)
-        return float(np.sqrt(need * scorer.s2 / e)) if e > 0 else float("inf")
+        return float(sizes([X])[0])
 
     out: list[dict[str, Any]] = []
     span = ctx.xrange[1] - ctx.xrange[0]
@@ -522,7 +531,7 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
             elif e == "cogging":
                 kmax = c.kmax(ctx)
                 ks = np.geomspace(1.5 / max(span, 1e-9), max(kmax, 2.0 / max(span, 1e-9)), 8)
-                amps = [size(sig.filt(np.sin(2 * np.pi * k * sig.x))) for k in ks]
+                amps = sizes([sig.filt(np.sin(2 * np.pi * k * sig.x)) for k in ks])
                 b = float(np.max(amps))
                 txt = (f"a cogging under {b:.2g} N at pitches {1e3 / ks[-1]:.3g} to "
                        f"{1e3 / ks[0]:.3g} mm, or any at pitches under {1e3 / kmax:.3g} mm "
@@ -542,10 +551,100 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
                 out.append(_hide(e, b, "-", f"a friction change under {100 * b:.2g} % over a "
                                  "tenth of the stroke"))
             elif e in ("stribeck_shape", "deadband", "resonance"):
-                out.append(_nonlinear_hidden(c, ctx, size))
+                out.append(_nonlinear_hidden(c, ctx, size, sizes))
         except (ValueError, ArithmeticError, np.linalg.LinAlgError):  # pragma: no cover
             continue
     return [o for o in out if o is not None]
+
+
+def revealed_size(scorer: Scorer, terms: list[Term], X: np.ndarray, *, alpha: float,
+                  min_gain: float, min_rms: float = 0.0) -> float:
+    """The smallest size ``b`` at which an effect ``b*X`` in this record would pass the
+    search's acceptance test (:func:`~lugre.diagnosis.search.accept` on the held-out
+    blocks, the ``terms`` already found in both fits), for either sign, and whose force
+    reaches ``min_rms`` [N] rms; ``inf`` when no size up to 64 times the first guess
+    passes. :func:`revealed_sizes` for one column."""
+    return float(revealed_sizes(scorer, terms, [X], alpha=alpha, min_gain=min_gain,
+                                min_rms=min_rms)[0])
+
+
+def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
+                   alpha: float, min_gain: float, min_rms: float = 0.0) -> np.ndarray:
+    """:func:`revealed_size` of several columns at once (their fits stacked).
+
+    The size is the effect's whole size in the record: the residual may already hold
+    some of it (an effect under the threshold, or noise along ``X``), which the fit with
+    the effect reads as its coefficient; what is added is the size less that. The fits
+    are linear in the residual, so the held-out errors of the fit without the effect are
+    quadratic in what is added (read from three residuals), and those of the fit with it
+    do not change (its free coefficient takes it up): every size is judged exactly, from
+    three fits without the column and one with it.
+    """
+    from .search import accept_many
+
+    m = len(Xs)
+    out = np.full(m, np.inf)
+    if m == 0:
+        return out
+    xs = [np.asarray(X, float).reshape(-1) for X in Xs]
+    parts = [scorer._assemble(terms + [Term(cand=None, h=None, X=x[:, None])]) for x in xs]
+    G_b = np.stack([p[0] for p in parts])  # (m, K, d+1, d+1)
+    h_b = np.stack([p[1] for p in parts])
+    ptol, cen = parts[0][2], parts[0][3]
+    d = G_b.shape[-1] - 1
+    K = G_b.shape[1]
+    new = scorer._fit(G_b, h_b, np.broadcast_to(ptol, (m, d + 1)),
+                      np.broadcast_to(cen, (m, d + 1)))
+    gx, xx, xr = G_b[:, :, :d, d], G_b[:, :, d, d], h_b[:, :, d]  # (m, K, d), (m, K)
+    G0, h0 = G_b[:, :, :d, :d], h_b[:, :, :d]
+    # what the design (base and terms) cannot absorb of each column, per unit: the
+    # first guess of the size, from the gain alone
+    Gt, gt, xxt = G0.sum(1), gx.sum(1), xx.sum(1)
+    try:
+        perp = xxt - np.einsum("mi,mi->m", gt, np.linalg.solve(
+            Gt + 1e-12 * np.trace(Gt, axis1=-2, axis2=-1)[:, None, None] * np.eye(d),
+            gt[..., None])[..., 0])
+    except np.linalg.LinAlgError:  # pragma: no cover
+        perp = xxt
+    good = (perp > 1e-12 * np.maximum(xxt, 1e-300)) & np.isfinite(perp)
+    b0 = np.where(good, np.sqrt((min_gain + 20.0) * scorer.s2 / np.where(good, perp, 1.0)),
+                  1.0)
+    # the fits without the column, of the residual plus -b0, 0 and b0 times it
+    bs = np.stack([-b0, 0.0 * b0, b0], axis=1)  # (m, 3)
+    f = scorer._fit(np.broadcast_to(G0[:, None], (m, 3) + G0.shape[1:]),
+                    h0[:, None] + bs[:, :, None, None] * gx[:, None],
+                    np.broadcast_to(ptol[:d], (m, 3, d)), np.broadcast_to(cen[:d], (m, 3, d)))
+    drr = 2 * bs[:, :, None] * xr[:, None] + bs[:, :, None] ** 2 * xx[:, None]  # (m, 3, K)
+    sse3 = f["sse_b"] + drr
+    score3 = f["score"] + drr.sum(-1) / scorer.s2
+    grid = 2.0 ** (np.arange(-24, 49) / 8.0)  # b0/8 to 64*b0, 9 % apart
+    for j in range(m):
+        if not good[j]:
+            continue
+        B0 = b0[j]
+
+        def quad(v: np.ndarray) -> tuple[Any, Any, Any]:
+            vm, v0, vp = v[0], v[1], v[2]
+            return v0, (vp - vm) / (2 * B0), (vp + vm - 2 * v0) / (2 * B0 ** 2)
+
+        qs, qp, qc = quad(sse3[j]), quad(f["prior"][j]), quad(score3[j])
+        held = float(new["b"][j, -1] / new["sc"][j, -1])  # the residual's share along x
+        c = B0 * np.concatenate([grid, -grid])[:, None]
+        b = c - held  # what is added to the residual for a whole size c
+        sse = qs[0][None] + qs[1][None] * b + qs[2][None] * b * b
+        prior = qp[0] + qp[1] * b + qp[2] * b * b
+        gains = (sse - new["sse_b"][j][None]) / scorer.s2 + (prior - new["prior"][j]) / K
+        gain = (qc[0] + qc[1] * b + qc[2] * b * b)[:, 0] - new["score"][j]
+        acc = accept_many(gains, gain, alpha=alpha, min_gain=min_gain)
+        ok = acc[:grid.size] & acc[grid.size:]  # for either sign
+        if not ok[-1]:
+            continue
+        fail = np.flatnonzero(~ok)
+        size = float(B0 * (grid[fail[-1] + 1] if fail.size else grid[0]))
+        xm = xs[j][scorer.mask]
+        rms = float(np.sqrt(np.mean(xm * xm))) if xm.size else 0.0
+        out[j] = max(size, min_rms / rms) if rms > 0 else np.inf
+    return out
 
 
 def _hide(effect: str, b: float, unit: str, what: str, rng: Any = None,
@@ -559,7 +658,7 @@ def _amps(a: float) -> str:
     return f"{a * 1e3:.3g} mA" if abs(a) < 1 else f"{a:.3g} A"
 
 
-def _nonlinear_hidden(c: Any, ctx: Any, size: Any) -> dict[str, Any] | None:
+def _nonlinear_hidden(c: Any, ctx: Any, size: Any, many: Any) -> dict[str, Any] | None:
     sig = ctx.sig
     if c.effect == "stribeck_shape":
         m = ctx.model
@@ -592,11 +691,11 @@ def _nonlinear_hidden(c: Any, ctx: Any, size: Any) -> dict[str, Any] | None:
         fs = sorted({h[0] for h in g})
         pts = [(f, 0.05, 0.5) for f in fs]
         cols = c.columns_many(pts, ctx) or [c.columns(h, ctx) for h in pts]  # (in parallel)
-        sizes = [size(X[:, 0]) for X in cols]  # in units of the half-mass load's force
+        sizes = list(many([X[:, 0] for X in cols]))  # in units of the half-mass load's force
         hidden = [f for f, sz in zip(fs, sizes) if sz > 1.0]
         if not hidden:
             # the load's force grows about in proportion to its share of the mass
-            b = 0.5 * max(sizes)
+            b = 0.5 * float(max(sizes))
             return _hide(c.effect, b, "load fraction",
                          f"a resonance with under {100 * b:.2g} % of the mass behind its "
                          f"coupling (lightly damped, at {fs[0]:.3g} to {fs[-1]:.3g} Hz)")

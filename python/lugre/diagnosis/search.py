@@ -20,6 +20,7 @@ sample count nor a white-noise information criterion measures the evidence. Inst
 
 from __future__ import annotations
 
+import copy
 import math
 import weakref
 from dataclasses import dataclass, field, replace
@@ -182,6 +183,17 @@ class Scorer:
                               "step": self.step}
         kw.update(changes)
         return Scorer(**kw)
+
+    def with_residual(self, r: np.ndarray) -> Scorer:
+        """The same scorer (base, rows, blocks, noise unit) of another residual ``r``:
+        only the residual's products are computed again."""
+        new = copy.copy(self)
+        new.r = r
+        new._rm = self._blocks_of(r[:, None])
+        new._hJ = self._gram(self._Jm, new._rm)[:, :, 0]
+        new._rr = self._gram(new._rm, new._rm)[:, 0, 0]
+        new._products = {}  # (a term's products with the residual changed)
+        return new
 
     def _stack(self, a: np.ndarray) -> np.ndarray:
         """``(n, c)`` samples as ``(K, n/K, c)`` blocks."""
@@ -594,6 +606,27 @@ def accept(ev: dict[str, float], *, alpha: float, min_gain: float) -> tuple[bool
         return True, "confined but overwhelming"
     return False, (f"not consistent over held-out blocks (gains in {ev['positive']} "
                    f"blocks, p = {ev['p']:.2g})")
+
+
+def accept_many(d: np.ndarray, gain: np.ndarray, *, alpha: float,
+                min_gain: float) -> np.ndarray:
+    """:func:`accept`'s decision for many sets of per-block gains at once: ``d``
+    ``(m, K)``, their score gains ``gain`` ``(m,)``; a boolean ``(m,)``."""
+    d = np.atleast_2d(d)
+    K = d.shape[-1]
+    sd = np.std(d, axis=-1, ddof=1)
+    mean = d.mean(-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(sd > 0, mean / (sd / np.sqrt(K)), np.where(mean > 0, np.inf, 0.0))
+    p = np.where(sd > 0, special.stdtr(K - 1, -np.where(np.isfinite(t), t, 0.0)),
+                 np.where(mean > 0, 0.0, 1.0))
+    pos = np.where(d > 0, d, 0.0).sum(-1)
+    neg = -np.where(d < 0, d, 0.0).sum(-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(neg > 0, pos / neg, np.inf)
+    npos = np.sum(d > 0, axis=-1)
+    return (gain > min_gain) & ((p < alpha) | ((gain > 20 * min_gain) & (npos >= 3)
+                                                & (ratio > 10)))
 
 
 def _pair(scorer: Scorer, terms: list[Term], cur: Evaluation, strong: list[tuple[Any, ...]],
