@@ -9,8 +9,8 @@ import lugre
 import numpy as np
 import pytest
 from lugre.diagnosis import diagnose, evaluate, fit_inverse_dynamics, write_plots
-from lugre.diagnosis.synth import concealed
 from lugre.diagnosis.search import accept, accept_many, block_evidence
+from lugre.diagnosis.synth import concealed
 from lugre.exceptions import DataError
 
 

@@ -483,7 +483,7 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
     revealed, by the search's own test.
 
     An effect of size ``b`` with column ``X`` (per unit size) is added to this record's
-    residual, and the held-out blocks judge it as the search would (:func:`revealed_size`,
+    residual, and the held-out blocks judge it as the search would (:func:`revealed_sizes`,
     with ``terms``, the terms found, in both fits): the size given is the smallest from
     which it passes for either sign. The noise, the record's own unevenness (an effect
     that lives in a few blocks passes the consistency test late) and the friction levels'
@@ -557,20 +557,13 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
     return [o for o in out if o is not None]
 
 
-def revealed_size(scorer: Scorer, terms: list[Term], X: np.ndarray, *, alpha: float,
-                  min_gain: float, min_rms: float = 0.0) -> float:
+def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
+                   alpha: float, min_gain: float, min_rms: float = 0.0) -> np.ndarray:
     """The smallest size ``b`` at which an effect ``b*X`` in this record would pass the
     search's acceptance test (:func:`~lugre.diagnosis.search.accept` on the held-out
     blocks, the ``terms`` already found in both fits), for either sign, and whose force
-    reaches ``min_rms`` [N] rms; ``inf`` when no size up to 64 times the first guess
-    passes. :func:`revealed_sizes` for one column."""
-    return float(revealed_sizes(scorer, terms, [X], alpha=alpha, min_gain=min_gain,
-                                min_rms=min_rms)[0])
-
-
-def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
-                   alpha: float, min_gain: float, min_rms: float = 0.0) -> np.ndarray:
-    """:func:`revealed_size` of several columns at once (their fits stacked).
+    reaches ``min_rms`` [N] rms, for each column ``X`` of ``Xs`` (their fits stacked);
+    ``inf`` when no size up to 64 times the first guess passes.
 
     The size is the effect's whole size in the record: the residual may already hold
     some of it (an effect under the threshold, or noise along ``X``), which the fit with
@@ -621,13 +614,8 @@ def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
     for j in range(m):
         if not good[j]:
             continue
-        B0 = b0[j]
-
-        def quad(v: np.ndarray) -> tuple[Any, Any, Any]:
-            vm, v0, vp = v[0], v[1], v[2]
-            return v0, (vp - vm) / (2 * B0), (vp + vm - 2 * v0) / (2 * B0 ** 2)
-
-        qs, qp, qc = quad(sse3[j]), quad(f["prior"][j]), quad(score3[j])
+        B0 = float(b0[j])
+        qs, qp, qc = (_quadratic(v, B0) for v in (sse3[j], f["prior"][j], score3[j]))
         held = float(new["b"][j, -1] / new["sc"][j, -1])  # the residual's share along x
         c = B0 * np.concatenate([grid, -grid])[:, None]
         b = c - held  # what is added to the residual for a whole size c
@@ -645,6 +633,13 @@ def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
         rms = float(np.sqrt(np.mean(xm * xm))) if xm.size else 0.0
         out[j] = max(size, min_rms / rms) if rms > 0 else np.inf
     return out
+
+
+def _quadratic(v: np.ndarray, h: float) -> tuple[Any, Any, Any]:
+    """Coefficients ``(a, b, c)`` of ``a + b*s + c*s^2`` through the values ``v`` at
+    ``s = -h, 0, h`` (along the first axis)."""
+    vm, v0, vp = v[0], v[1], v[2]
+    return v0, (vp - vm) / (2 * h), (vp + vm - 2 * v0) / (2 * h ** 2)
 
 
 def _hide(effect: str, b: float, unit: str, what: str, rng: Any = None,

@@ -20,7 +20,6 @@ sample count nor a white-noise information criterion measures the evidence. Inst
 
 from __future__ import annotations
 
-import copy
 import math
 import weakref
 from dataclasses import dataclass, field, replace
@@ -183,17 +182,6 @@ class Scorer:
                               "step": self.step}
         kw.update(changes)
         return Scorer(**kw)
-
-    def with_residual(self, r: np.ndarray) -> Scorer:
-        """The same scorer (base, rows, blocks, noise unit) of another residual ``r``:
-        only the residual's products are computed again."""
-        new = copy.copy(self)
-        new.r = r
-        new._rm = self._blocks_of(r[:, None])
-        new._hJ = self._gram(self._Jm, new._rm)[:, :, 0]
-        new._rr = self._gram(new._rm, new._rm)[:, 0, 0]
-        new._products = {}  # (a term's products with the residual changed)
-        return new
 
     def _stack(self, a: np.ndarray) -> np.ndarray:
         """``(n, c)`` samples as ``(K, n/K, c)`` blocks."""
