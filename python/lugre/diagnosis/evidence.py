@@ -276,13 +276,21 @@ def _start(scorer: Scorer, terms: list[Term], k: int) -> int:
     return scorer.J.shape[1] + sum(t.X.shape[1] for t in terms[:k])
 
 
-def _refit_on(scorer: Scorer, terms: list[Term], k: int, sel: np.ndarray
-              ) -> tuple[float, float] | None:
+def _refit_on(scorer: Scorer, terms: list[Term], k: int, sel: np.ndarray,
+              nuisance: list[Term] | None = None) -> tuple[float, float] | None:
     """The first coefficient of ``terms[k]`` refitted, jointly with the base and the
-    other terms, on the samples ``sel`` alone, and its standard error; None when those
+    other terms (and the ``nuisance`` terms, whose share of its column it does not
+    claim), on the samples ``sel`` alone, and its standard error; None when those
     samples hold nothing of its column."""
-    x = terms[k].X[:, 0]
-    sxx = float(np.sum(x[sel] ** 2))
+    x = terms[k].X[sel, 0]
+    terms = list(terms) + list(nuisance or [])
+    # its standard error from what the base and the other terms leave of its column
+    # there (their priors ignored: a bound from above)
+    others = [scorer.J[sel]] + [t.X[sel] for i, t in enumerate(terms) if i != k]
+    D = np.column_stack(others)
+    if D.shape[1]:
+        x = x - D @ np.linalg.lstsq(D, x, rcond=None)[0]
+    sxx = float(np.sum(x ** 2))
     if not sxx > 0:
         return None
     ev = scorer.like(mask=sel, center=None).evaluate(terms)
@@ -301,6 +309,8 @@ def lag_at_reversals(scorer: Scorer, terms: list[Term], k: int, ev: Any,
     samples more than 50 ms from any reversal; when that record determines it (its
     standard error a quarter of the full fit's lag or less) and it is under half the
     full fit's, more than four standard errors below, the lag is a reversal mismatch.
+    A mass error is fitted beside it there when no mass term is in (the believed mass
+    is never exact, and between reversals the force changes with the acceleration).
     Returns the figures, or None when the record cannot tell.
     """
     sig = ctx.sig
@@ -309,7 +319,12 @@ def lag_at_reversals(scorer: Scorer, terms: list[Term], k: int, ev: Any,
     if nrev == 0 or away.sum() < 0.2 * scorer.mask.sum():
         return None
     tau = float(ev.beta[_start(scorer, terms, k)])
-    fit = _refit_on(scorer, terms, k, away) if tau > 0 else None
+    nuisance = None
+    if not any(t.effect == "mass" for t in terms if t.cand is not None):
+        from .effects import Mass
+
+        nuisance = [Term(cand=Mass(), h=None, X=Mass().columns(None, ctx))]
+    fit = _refit_on(scorer, terms, k, away, nuisance) if tau > 0 else None
     if fit is None:
         return None
     tau_away, se = fit
@@ -487,10 +502,11 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
     with ``terms``, the terms found, in both fits): the size given is the smallest from
     which it passes for either sign. The noise, the record's own unevenness (an effect
     that lives in a few blocks passes the consistency test late) and the friction levels'
-    share of the effect all count, as they do in the search. So does its practical
-    size: a finding's force must reach ``min_effect`` times the noise floor
-    ``noise_rms`` and (but for timing) ``min_force``, or it is at most a minor
-    correction.
+    share of the effect all count, as they do in the search. So do its other rules: a
+    finding's force must reach ``min_effect`` times the noise floor ``noise_rms`` and
+    (but for timing) ``min_force``, or it is at most a minor correction; an effect that
+    adds most of what the friction levels cannot absorb in one held-out stretch is
+    never named; a lag must reach a fifth of the sample interval.
     """
     found_terms = list(terms or [])
     sig = ctx.sig
@@ -499,8 +515,11 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
         # (a minor correction of the same kind, kept in the fit, is part of the effect)
         rest = [t for t in found_terms if t.cand is None or t.effect != e]
         floor = max(min_effect * noise_rms, 0.0 if e == "delay" else min_force)
-        return revealed_sizes(scorer, rest, Xs, alpha=alpha, min_gain=min_gain,
-                              min_rms=floor)
+        out = revealed_sizes(scorer, rest, Xs, alpha=alpha, min_gain=min_gain,
+                             min_rms=floor)
+        # a lag under a fifth of the sample interval is a detail of the sampling
+        dt = sig.info.get("dt_logged", sig.dt)  # the record's own sample interval
+        return np.maximum(out, 0.2 * dt) if e == "delay" else out
 
     def size(X: np.ndarray) -> float:
         return float(sizes([X])[0])
@@ -514,41 +533,49 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
         try:
             if e == "offset":
                 b = size(np.ones(len(sig)))
-                out.append(_hide(e, b, "N", f"a constant force under {b:.2g} N", experiment=(
+                out.append(_hide(e, b, "N", f"a constant force {_under(b, '{:.2g} N')}", experiment=(
                     "per-direction friction levels absorb a constant force while the axis "
                     "moves; " + EXPERIMENT[("offset", "asymmetry")].split(":")[0]
                     + " separates them")))
             elif e == "spring":
                 b = size(sig.x - np.mean(sig.x[sig.mask]))
-                out.append(_hide(e, b, "N/m", f"a spring under {b:.3g} N/m "
-                                 f"({b * span:.2g} N over the stroke)"))
+                out.append(_hide(e, b, "N/m", f"a spring {_under(b, '{:.3g} N/m')}"
+                                 + (f" ({b * span:.2g} N over the stroke)" if np.isfinite(b) else "")))
             elif e == "mass":
                 b = size(sig.a)
-                out.append(_hide(e, b, "kg", f"a payload under {b:.2g} kg"))
+                out.append(_hide(e, b, "kg", f"a payload {_under(b, '{:.2g} kg')}"))
             elif e == "drag":
                 b = size(sig.filt(np.abs(sig.v) * sig.v))
-                out.append(_hide(e, b, "N s^2/m^2", f"a drag under {b:.3g} N s^2/m^2"))
+                out.append(_hide(e, b, "N s^2/m^2", f"a drag {_under(b, '{:.3g} N s^2/m^2')}"))
             elif e == "cogging":
                 kmax = c.kmax(ctx)
                 ks = np.geomspace(1.5 / max(span, 1e-9), max(kmax, 2.0 / max(span, 1e-9)), 8)
                 amps = sizes([sig.filt(np.sin(2 * np.pi * k * sig.x)) for k in ks])
-                b = float(np.max(amps))
-                txt = (f"a cogging under {b:.2g} N at pitches {1e3 / ks[-1]:.3g} to "
-                       f"{1e3 / ks[0]:.3g} mm, or any at pitches under {1e3 / kmax:.3g} mm "
-                       "(faster than the filter band at this record's slowest motion),")
+                seen = np.isfinite(amps)
+                b = float(np.max(amps[seen])) if seen.any() else float("inf")
+                blind = ""
+                if seen.any() and not seen.all():
+                    pb = 1e3 / ks[~seen]
+                    blind = (f" (of any size at pitches near {pb.min():.3g} to {pb.max():.3g} "
+                             "mm: what the friction levels cannot absorb lies in one "
+                             "held-out stretch)")
+                txt = (f"a cogging {_under(b, '{:.2g} N')} at pitches {1e3 / ks[-1]:.3g} to "
+                       f"{1e3 / ks[0]:.3g} mm{blind}, or any at pitches under "
+                       f"{1e3 / kmax:.3g} mm (faster than the filter band at this record's "
+                       "slowest motion),")
                 out.append(_hide(e, b, "N", txt, experiment=(
                     "slow constant-speed passes (a few mm/s) show short pitches")))
             elif e == "delay":
                 b = size(sig.dfm)
                 out.append(_hide("delay/current_lag", b, "s",
-                                 f"a delay or current lag under {b * 1e3:.2g} ms"))
+                                 f"a delay or current lag {_under(b * 1e3, '{:.2g} ms')}"))
             elif e == "drift":
                 b = size((sig.t / max(sig.t[-1], 1e-9)) * ctx.fcs)
-                out.append(_hide(e, b, "-", f"a friction drift under {100 * b:.2g} % over the "
+                out.append(_hide(e, b, "-", f"a friction drift {_under(100 * b, '{:.2g} %')} over the "
                                  "record"))
             elif e == "position_friction":
                 b = size(sig.filt(ctx.fcs * (np.abs(sig.x - np.mean(sig.x)) < 0.1 * span)))
-                out.append(_hide(e, b, "-", f"a friction change under {100 * b:.2g} % over a "
+                out.append(_hide(e, b, "-", f"a friction change {_under(100 * b, '{:.2g} %')} over a "
                                  "tenth of the stroke"))
             elif e in ("stribeck_shape", "deadband", "resonance"):
                 out.append(_nonlinear_hidden(c, ctx, size, sizes))
@@ -573,7 +600,7 @@ def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
     do not change (its free coefficient takes it up): every size is judged exactly, from
     three fits without the column and one with it.
     """
-    from .search import accept_many
+    from .search import _one_block, accept_many
 
     m = len(Xs)
     out = np.full(m, np.inf)
@@ -612,8 +639,8 @@ def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
     score3 = f["score"] + drr.sum(-1) / scorer.s2
     grid = 2.0 ** (np.arange(-24, 49) / 8.0)  # b0/8 to 64*b0, 9 % apart
     for j in range(m):
-        if not good[j]:
-            continue
+        if not good[j] or _one_block(scorer, xs[j]) is not None:
+            continue  # (most of what it adds in one held-out stretch: never named)
         B0 = float(b0[j])
         qs, qp, qc = (_quadratic(v, B0) for v in (sse3[j], f["prior"][j], score3[j]))
         held = float(new["b"][j, -1] / new["sc"][j, -1])  # the residual's share along x
@@ -633,6 +660,11 @@ def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
         rms = float(np.sqrt(np.mean(xm * xm))) if xm.size else 0.0
         out[j] = max(size, min_rms / rms) if rms > 0 else np.inf
     return out
+
+
+def _under(b: float, fmt: str) -> str:
+    """"under 0.3 N" for a finite size, "of any size" for none."""
+    return "under " + fmt.format(b) if np.isfinite(b) else "of any size"
 
 
 def _quadratic(v: np.ndarray, h: float) -> tuple[Any, Any, Any]:
@@ -676,8 +708,8 @@ def _nonlinear_hidden(c: Any, ctx: Any, size: Any, many: Any) -> dict[str, Any] 
         d0 = 0.02
         b = d0 * size(c.columns(d0, ctx)[:, 0])
         kf = ctx.model.force_constant
-        return _hide(c.effect, b, "A", f"a dead-band under {_amps(b)} ({b * kf:.2g} N of motor "
-                     "force)")
+        return _hide(c.effect, b, "A", (f"a dead-band under {_amps(b)} ({b * kf:.2g} N of motor force)"
+                     if np.isfinite(b) else "a dead-band of any size"))
     if c.effect == "resonance":
         g = c.grid(ctx)
         if g is None:
