@@ -283,18 +283,28 @@ def _refit_on(scorer: Scorer, terms: list[Term], k: int, sel: np.ndarray,
     claim), on the samples ``sel`` alone, and its standard error; None when those
     samples hold nothing of its column."""
     x = terms[k].X[sel, 0]
-    terms = list(terms) + list(nuisance or [])
-    # its standard error from what the base and the other terms leave of its column
-    # there (their priors ignored: a bound from above)
-    others = [scorer.J[sel]] + [t.X[sel] for i, t in enumerate(terms) if i != k]
-    D = np.column_stack(others)
-    if D.shape[1]:
-        x = x - D @ np.linalg.lstsq(D, x, rcond=None)[0]
+    if nuisance:  # (their share of the column is not the term's)
+        N = np.column_stack([t.X[sel, 0] for t in nuisance])
+        x = x - N @ np.linalg.lstsq(N, x, rcond=None)[0]
+        terms = list(terms) + list(nuisance)
     sxx = float(np.sum(x ** 2))
     if not sxx > 0:
         return None
     ev = scorer.like(mask=sel, center=None).evaluate(terms)
     return float(ev.beta[_start(scorer, terms, k)]), float(np.sqrt(scorer.s2 / sxx))
+
+
+def _rate_noise_power(sig: Any) -> float:
+    """Mean square per sample of the recorded force's noise in its filtered rate of
+    change (``sig.dfm``): the white level above the motion's band through the
+    residual's low-pass and the central difference; 0 when it cannot be read."""
+    level = R.hf_level(sig.info.get("fm_logged", sig.fm)[sig.mask], sig.fs)
+    if level is None:
+        return 0.0
+    ff, f2 = R.filter_power(sig)
+    d2 = (np.sin(2 * np.pi * ff * sig.dt) / sig.dt) ** 2  # np.gradient's response
+    w = f2 * d2  # (the force is low-passed as the residual is)
+    return float(level * np.sum(0.5 * (w[1:] + w[:-1])) * (ff[1] - ff[0]))
 
 
 def lag_at_reversals(scorer: Scorer, terms: list[Term], k: int, ev: Any,
@@ -328,6 +338,25 @@ def lag_at_reversals(scorer: Scorer, terms: list[Term], k: int, ev: Any,
     if fit is None:
         return None
     tau_away, se = fit
+    # the lag's column is the recorded force's rate of change, and the current's own
+    # noise in it pulls the fitted lag toward zero by the noise's share of the column
+    # (errors in variables): little at the reversals, where the force changes fast,
+    # much between them. Both fits are corrected; where the noise is most of the
+    # column there, those samples cannot tell
+    nn = _rate_noise_power(sig)
+    if nn > 0.0:
+        x = sig.dfm
+        for name, sel in (("full", scorer.mask), ("away", away)):
+            sxx = float(np.sum(x[sel] ** 2))
+            share = sel.sum() * nn / sxx if sxx > 0 else 1.0
+            if share > 0.75:
+                if name == "away":
+                    return None
+                share = 0.75
+            if name == "full":
+                tau = float(tau / (1.0 - share))
+            else:
+                tau_away, se = float(tau_away / (1.0 - share)), float(se / (1.0 - share))
     return {"lag_s": tau, "lag_away_s": tau_away, "se_s": se, "reversals": nrev,
             "reversals_only": bool(se < 0.25 * tau and tau_away < 0.5 * tau
                                    and tau - tau_away > 4.0 * se)}
