@@ -718,3 +718,14 @@ def test_a_delay_between_slow_reversals_is_not_lost_motion():
     assert "mass" in names and names & {"delay", "current_lag"}, dg.summary()
     lag = next(f for f in dg.findings if f.effect in ("delay", "current_lag"))
     assert lag.parameters["seconds"] == pytest.approx(0.000765, rel=0.3)
+
+
+def test_a_model_with_its_timing_is_diagnosed_again():
+    # the timing term is one of a kind (a delay and a lag at most once each): a model
+    # that holds one is diagnosed with it kept as given
+    rec, believed, _ = concealed({"effect": "current_lag", "bandwidth": 60.0}, duration=10.0)
+    first = diagnose(rec, believed, closed_loop=False)
+    assert {f.effect for f in first.findings} & {"delay", "current_lag"}
+    again = diagnose(rec, first.augmented_model(), closed_loop=False)
+    assert not {f.effect for f in again.findings} & {"delay", "current_lag"}
+    assert any("already holds its timing" in n for n in again.notes)

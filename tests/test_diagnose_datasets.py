@@ -92,3 +92,19 @@ def test_clean_record_holds_the_presliding_parameters():
     # the public resonance (75 % of the mass at 22 Hz) would be seen on this record
     assert 0 < hidden["resonance"]["smallest"] < 0.75, hidden["resonance"]
     assert dg.verdict.startswith("Nothing found")
+
+
+@pytest.mark.parametrize("case", ["resonance", "stribeck_shape"])
+def test_diagnosing_the_augmented_model_again(case):
+    # a model may hold one resonance, one Stribeck shape and one timing term: diagnosed
+    # again, the augmented model made the search add a second and stopped with "holds
+    # more than one resonance" (a crash of the natural second pass). Those it holds are
+    # kept as given, said so, and nothing more is found
+    d = MISMATCH / case
+    rec = lugre.read_recording(d / "recording.csv")
+    first = diagnose(rec, lugre.load_model(d / "model.json"), closed_loop=False)
+    assert [f.effect for f in first.findings] == [case]
+    again = diagnose(rec, first.augmented_model(), closed_loop=False)
+    assert again.findings == [], again.summary()
+    assert any("already holds its" in n for n in again.notes)
+    assert case not in {h["effect"] for h in again.could_not_reveal}

@@ -364,6 +364,10 @@ def _diagnose(
 
     # 3. search: greedy forward selection over the vocabulary, held-out blocks
     cands = E.candidates()
+    # one of a kind in a model: a resonance, a Stribeck shape and a timing term the
+    # model already holds are kept as given (diagnosing an augmented model again)
+    held_kinds = _held_kinds(model)
+    cands = [c for c in cands if c.effect not in held_kinds]
     if free_mass:
         cands = [c for c in cands if c.effect != "mass"]
     if candidates is not None:
@@ -727,6 +731,11 @@ def _diagnose(
 
     base_rep = V.base_report(model, base, names, presliding)
     notes = V.base_notes(base_rep, findings) + noise_notes
+    if held_kinds:
+        kinds = sorted({"timing" if k == "delay" else k.replace("_", " ")
+                        for k in held_kinds})
+        notes.append(f"The model already holds its {' and '.join(kinds)} (one of a kind): "
+                     "kept as given, not searched again.")
     fit: dict[str, Any] = {"before": _metrics(r0, sig.fm_f, sig.mask),
                            "after": _metrics(r1, sig.fm_f, sig.mask),
                            "holdout_before": {}, "holdout_after": {}}
@@ -766,7 +775,8 @@ def _diagnose(
             f"{PARTIAL_REST:g} times the noise floor and less than 90 % is explained: "
             "physics outside the vocabulary is likelier than that name.")
     kept = {t.effect for t in terms}
-    hidden = V.could_not_reveal(scorer, ctx, E.candidates(),
+    hidden = V.could_not_reveal(scorer, ctx,
+                                [c for c in E.candidates() if c.effect not in held_kinds],
                                 [t.effect for t in terms if not t.minor],
                                 min_gain, terms=[t for t in terms_sel if t.effect in kept],
                                 alpha=alpha, noise_rms=noise["rms"], min_force=min_force)
@@ -790,6 +800,16 @@ def _diagnose(
     dg.base_moves = V.base_moves(base_rep)
     dg.verdict = V.verdict(dg)
     return dg
+
+
+def _held_kinds(model: Model) -> set[str]:
+    """Candidates the model leaves no room for: effects it may hold once and already
+    holds (the timing candidate is ``delay``, for both of its forms)."""
+    have = {e["effect"] for e in model.effects}
+    kinds = {k for k in ("resonance", "stribeck_shape") if k in have}
+    if have & {"delay", "current_lag"}:
+        kinds.add("delay")
+    return kinds
 
 
 def _rms(y: np.ndarray, mask: np.ndarray) -> float:
