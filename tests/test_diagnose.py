@@ -729,3 +729,21 @@ def test_a_model_with_its_timing_is_diagnosed_again():
     again = diagnose(rec, first.augmented_model(), closed_loop=False)
     assert not {f.effect for f in again.findings} & {"delay", "current_lag"}
     assert any("already holds its timing" in n for n in again.notes)
+
+
+def test_the_current_noise_in_the_force_rate_is_predicted():
+    # the reversal check corrects the lag for the current's noise in its column (the
+    # filtered force's rate of change): that noise's mean square, predicted from the
+    # level above the band, matches what white current noise gives
+    from lugre.diagnosis import residual as R
+    from lugre.diagnosis.evidence import _rate_noise_power
+
+    rng = np.random.default_rng(5)
+    n = 20000
+    t = np.arange(n) * 1e-3
+    x = 0.05 * np.sin(2 * np.pi * 0.5 * t)
+    for sd in (0.01, 0.05):
+        rec = lugre.Recording(t=t, x=x, i=sd * rng.standard_normal(n))
+        sig = R.prepare(rec, lugre.Model.paper())
+        measured = float(np.mean(sig.dfm[sig.mask] ** 2))
+        assert _rate_noise_power(sig) == pytest.approx(measured, rel=0.1)
