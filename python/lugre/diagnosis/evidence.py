@@ -629,7 +629,7 @@ def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
     do not change (its free coefficient takes it up): every size is judged exactly, from
     three fits without the column and one with it.
     """
-    from .search import _one_block, accept_many
+    from .search import _ONE_BLOCK, accept_many
 
     m = len(Xs)
     out = np.full(m, np.inf)
@@ -667,24 +667,42 @@ def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
     sse3 = f["sse_b"] + drr
     score3 = f["score"] + drr.sum(-1) / scorer.s2
     grid = 2.0 ** (np.arange(-24, 49) / 8.0)  # b0/8 to 64*b0, 9 % apart
+    G = grid.size
+    # all columns and sizes at once: (m, 2G) sizes, either sign, in units of b0
+    qs = _quadratic(np.moveaxis(sse3, 1, 0), b0[:, None])  # each (m, K)
+    qp = _quadratic(np.moveaxis(f["prior"], 1, 0), b0)  # each (m,)
+    qc = _quadratic(np.moveaxis(score3, 1, 0), b0)
+    held = new["b"][:, -1] / new["sc"][:, -1]  # what the residual holds along each x
+    c = b0[:, None] * np.concatenate([grid, -grid])[None, :]
+    add = c - held[:, None]  # what is added to the residual for a whole size c
+    sse = (qs[0][:, None] + qs[1][:, None] * add[..., None]
+           + qs[2][:, None] * add[..., None] ** 2)  # (m, 2G, K)
+    prior = qp[0][:, None] + qp[1][:, None] * add + qp[2][:, None] * add ** 2
+    gains = ((sse - new["sse_b"][:, None]) / scorer.s2
+             + ((prior - new["prior"][:, None]) / K)[..., None])
+    gain = qc[0][:, None] + qc[1][:, None] * add + qc[2][:, None] * add ** 2 \
+        - new["score"][:, None]
+    acc = accept_many(gains.reshape(m * 2 * G, K), gain.reshape(-1), alpha=alpha,
+                      min_gain=min_gain).reshape(m, 2 * G)
+    ok = acc[:, :G] & acc[:, G:]  # for either sign
+    # what the base cannot absorb of each column, per held-out block (as the search's
+    # one-stretch rule reads it, from the products already at hand)
+    q = scorer.J.shape[1]
+    if q:
+        GJ, gJ = G_b[:, :, :q, :q], gx[:, :, :q]
+        beta = np.array([np.linalg.lstsq(GJ[j].sum(0), gJ[j].sum(0), rcond=None)[0]
+                         for j in range(m)])
+        e_blk = (xx - 2 * np.einsum("mki,mi->mk", gJ, beta)
+                 + np.einsum("mi,mkij,mj->mk", beta, GJ, beta))
+    else:
+        e_blk = xx
+    e_tot = e_blk.sum(1)
+    one = (e_tot > 0) & (e_blk.max(1) > _ONE_BLOCK * np.where(e_tot > 0, e_tot, 1.0))
     for j in range(m):
-        if not good[j] or _one_block(scorer, xs[j]) is not None:
-            continue  # (most of what it adds in one held-out stretch: never named)
-        B0 = float(b0[j])
-        qs, qp, qc = (_quadratic(v, B0) for v in (sse3[j], f["prior"][j], score3[j]))
-        held = float(new["b"][j, -1] / new["sc"][j, -1])  # the residual's share along x
-        c = B0 * np.concatenate([grid, -grid])[:, None]
-        b = c - held  # what is added to the residual for a whole size c
-        sse = qs[0][None] + qs[1][None] * b + qs[2][None] * b * b
-        prior = qp[0] + qp[1] * b + qp[2] * b * b
-        gains = (sse - new["sse_b"][j][None]) / scorer.s2 + (prior - new["prior"][j]) / K
-        gain = (qc[0] + qc[1] * b + qc[2] * b * b)[:, 0] - new["score"][j]
-        acc = accept_many(gains, gain, alpha=alpha, min_gain=min_gain)
-        ok = acc[:grid.size] & acc[grid.size:]  # for either sign
-        if not ok[-1]:
-            continue
-        fail = np.flatnonzero(~ok)
-        size = float(B0 * (grid[fail[-1] + 1] if fail.size else grid[0]))
+        if not good[j] or not ok[j, -1] or one[j]:
+            continue  # (one held-out stretch holding most of what it adds: never named)
+        fail = np.flatnonzero(~ok[j])
+        size = float(b0[j] * (grid[fail[-1] + 1] if fail.size else grid[0]))
         xm = xs[j][scorer.mask]
         rms = float(np.sqrt(np.mean(xm * xm))) if xm.size else 0.0
         out[j] = max(size, min_rms / rms) if rms > 0 else np.inf
@@ -696,7 +714,7 @@ def _under(b: float, fmt: str) -> str:
     return "under " + fmt.format(b) if np.isfinite(b) else "of any size"
 
 
-def _quadratic(v: np.ndarray, h: float) -> tuple[Any, Any, Any]:
+def _quadratic(v: np.ndarray, h: Any) -> tuple[Any, Any, Any]:
     """Coefficients ``(a, b, c)`` of ``a + b*s + c*s^2`` through the values ``v`` at
     ``s = -h, 0, h`` (along the first axis)."""
     vm, v0, vp = v[0], v[1], v[2]
