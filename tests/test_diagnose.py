@@ -773,3 +773,14 @@ def test_clean_records_of_an_unseen_set_name_nothing(setup):
     dg = diagnose(rec, believed, closed_loop=False)
     assert dg.findings == [], dg.summary()
     assert any("SIMEX" in n for n in dg.notes)
+
+
+def test_the_timing_alternative_reads_in_words():
+    # a lag beside a delay it is not told apart from reads with its bandwidth and its
+    # effective delay, not as a raw parameter dictionary
+    rec, believed, _ = concealed({"effect": "current_lag", "bandwidth": 120.0}, duration=10.0)
+    dg = diagnose(rec, believed, closed_loop=False)
+    f = next(f for f in dg.findings if f.effect in ("delay", "current_lag"))
+    assert f.alternatives  # (at 1 kHz the record does not tell a 120 Hz lag apart)
+    line = next(ln for ln in dg.summary().splitlines() if "Equally well" in ln)
+    assert re.search(r"bandwidth \d+ Hz, effective delay [\d.]+ ms", line), line

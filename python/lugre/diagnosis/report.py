@@ -213,7 +213,15 @@ class Diagnosis:
             lines.append(line.replace("\u2212", "-"))
             lines.append(f"   {plain_text(f.evidence)}")
             for alt in f.alternatives:
-                lines.append(f"   Equally well: {alt['effect']} {_fmt(alt['parameters'])}. "
+                ap = alt.get("parameters") or {}
+                if alt["effect"] in ("delay", "current_lag"):
+                    from .timing import timing_words
+
+                    ap_txt = "(" + timing_words(alt["effect"], {
+                        **ap, "seconds": alt.get("effective_delay_s", ap.get("seconds"))}) + ")"
+                else:
+                    ap_txt = _fmt(ap)
+                lines.append(f"   Equally well: {alt['effect']} {ap_txt}. "
                              f"To separate: {alt['experiment']}")
         if self.minor:
             lines.append(
