@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 from concealed_cases import save_case  # benches/ is the script's folder
 from lugre import Model
-from lugre.diagnosis.synth import axis_model, case
+from lugre.diagnosis.synth import axis_model, case, trajectory
 
 EFFECTS = ("cogging", "offset", "spring", "drift", "mass", "delay", "current_lag",
            "deadband", "drag", "stribeck_shape", "resonance", "position_friction")
@@ -32,8 +32,10 @@ EFFECTS = ("cogging", "offset", "spring", "drift", "mass", "delay", "current_lag
 EXCLUSIVE = ({"delay", "current_lag"}, {"offset", "spring"})
 
 
-def sized(name: str, ax: Model, rng: np.random.Generator, stroke: float) -> dict[str, Any]:
-    """One effect, sized against the axis at 0.6-1.2 times the half sizes."""
+def sized(name: str, ax: Model, rng: np.random.Generator, stroke: float,
+          xrange: tuple[float, float] | None = None) -> dict[str, Any]:
+    """One effect, sized against the axis at 0.6-1.2 times the half sizes; ``xrange``
+    the positions the case's trajectory covers (a friction bump is placed inside)."""
     k = float(rng.uniform(0.6, 1.2))
     fc = 0.5 * (ax.positive["fc"] + ax.negative["fc"])
     kf = float(ax.force_constant)
@@ -66,8 +68,17 @@ def sized(name: str, ax: Model, rng: np.random.Generator, stroke: float) -> dict
                 "damping_ratio": float(rng.uniform(0.03, 0.08)),
                 "load_fraction": float(rng.uniform(0.5, 0.8))}
     if name == "position_friction":
-        c = float(rng.uniform(-0.5, 0.5)) * stroke
+        u = float(rng.uniform(-0.5, 0.5))
+        c = u * stroke
         w = 0.15 * stroke
+        if xrange is not None:
+            # inside the inner 80 % of what the trajectory covers (constant-speed feeds
+            # run from 0 forward only: a bump drawn about 0 could lie off the record)
+            lo, hi = xrange
+            span = hi - lo
+            if not lo + 0.1 * span <= c <= hi - 0.1 * span:
+                c = 0.5 * (lo + hi) + 0.8 * u * span
+                w = 0.15 * min(stroke, span)
         gain = 0.25 * k
         xs = np.linspace(c - 3 * w, c + 3 * w, 25)
         sc = 1.0 + gain * np.exp(-0.5 * ((xs - c) / w) ** 2)
@@ -96,7 +107,9 @@ def write(out: Path, name: str, effects: list[str], seed: int,
     # the stroke synth.case draws for the recording on a random axis (the paper axis: 0.15 m)
     stroke = (0.15 if cond["axis_seed"] is None
               else float(np.random.default_rng(seed + 1000).uniform(0.05, 0.3)))
-    truth = [sized(e, ax, rng, stroke) for e in effects]
+    n = int(cond["duration"] * cond["rate_hz"])
+    xr = trajectory(cond["kind"], np.arange(n) / cond["rate_hz"], seed, stroke)
+    truth = [sized(e, ax, rng, stroke, (float(xr.min()), float(xr.max()))) for e in effects]
     sim = [{k: v for k, v in e.items() if k != "generated_as"} for e in truth]
     rec, hold, believed, _ = case(sim, seed=seed, **cond)
     save_case(out / name, rec, hold, believed, truth, {**cond, "seed": seed}, fmt="%.10g")
