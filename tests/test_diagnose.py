@@ -585,8 +585,9 @@ def test_simex_surrogates_match_the_readings_noise():
 
 
 def test_a_dead_band_is_the_same_where_the_drive_brakes():
-    # a 27 % friction bump over a fifth of the stroke of an 88 kg axis on constant-speed
-    # feeds had been named a dead-band ("confined but overwhelming"): refitted where
+    # a 27 % friction bump centred 76 mm behind the start of an 88 kg axis's
+    # constant-speed feeds (which run from 0 to 711 mm: the record holds only its tail)
+    # had been named a dead-band ("confined but overwhelming"): refitted where
     # the drive brakes the axis, that dead-band read 2.0 times its band against 0.56
     # overall. A dead-band is one size wherever the current is over it (the public
     # dead-band reads 1.05 braking and 1.03 overall and stays named: datasets tests)
