@@ -785,3 +785,14 @@ def test_the_timing_alternative_reads_in_words():
     assert f.alternatives  # (at 1 kHz the record does not tell a 120 Hz lag apart)
     line = next(ln for ln in dg.summary().splitlines() if "Equally well" in ln)
     assert re.search(r"bandwidth \d+ Hz, effective delay [\d.]+ ms", line), line
+
+
+def test_an_offset_is_not_a_spring_with_its_rest_point_far_away():
+    # a 3 N offset on 30 s of sines logged at 10 kHz was named a spring of -0.0175 N/m
+    # with x0 at 171 m (on a 0.15 m stroke): the slope, 0.04 N rms beyond the offset,
+    # was a small mass error the positions of the sines follow. What a term adds beyond
+    # the simpler one it contains must be of practical size, as any finding
+    rec, believed, _ = concealed("offset", duration=30.0, rate_hz=10000.0)
+    dg = diagnose(rec, believed, closed_loop=False)
+    assert [f.effect for f in dg.findings] == ["offset"], dg.summary()
+    assert dg.findings[0].parameters["force"] == pytest.approx(3.0, rel=0.05)

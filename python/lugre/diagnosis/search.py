@@ -811,17 +811,58 @@ def forward_select(
         # parsimony: a term that contains a simpler one (spring contains offset) must
         # pass the same test against it, or the simpler story is told
         bc = okays.get(log[best[3]]["effect"])
+        # (and when it would replace the simpler one already found, add a force of
+        # practical size beyond it, or the search goes on without it)
+        held = [s_ for s_ in (bc[4].supersedes if bc else ()) if s_ in chosen]
+        if held and _rms_between((None, terms, cur), best, q, m, held[0]) < max(
+                min_force, min_effect * noise_rms):
+            log[best[3]]["ok"] = False
+            log[best[3]]["why"] += (f"; not taken: beyond the {held[0]} found it adds a "
+                                    "force under the practical size (parsimony)")
+            cands = [c for c in cands if c.effect != log[best[3]]["effect"]]
+            continue
         for simple in (bc[4].supersedes if bc else ()):
             if simple in okays:
                 nested = compare(okays[simple][2], best[2], s2)
-                if not accept(nested, alpha=alpha, min_gain=min_gain)[0]:
+                # what the larger term adds beyond the simpler one must also be of
+                # practical size (an offset read as a spring of -0.0175 N/m with x0 at
+                # 171 m on a 0.15 m stroke: 0.003 N of slope, bought by a small mass
+                # error the sines' positions follow)
+                extra = _rms_between(okays[simple], best, q, m)
+                if (not accept(nested, alpha=alpha, min_gain=min_gain)[0]
+                        or extra < max(min_force, min_effect * noise_rms)):
                     best = okays[simple][:4]
                     log[best[3]]["why"] += ("; preferred to a term containing it, which "
-                                            "does not pass the test against it (parsimony)")
+                                            "does not pass the test against it (parsimony)"
+                                            if extra >= max(min_force, min_effect * noise_rms)
+                                            else "; preferred to a term containing it, "
+                                            f"which adds {extra:.2g} N rms beyond it: under "
+                                            "the practical size (parsimony)")
         _, terms, cur, li = best
         log[li]["accepted"] = True
         terms, cur = _reprofile(scorer, terms, cur, ctx)
     return terms, cur, log
+
+
+def _contribution(trial: list[Term], ev: Evaluation, j: int, q: int) -> np.ndarray:
+    """The force [N] term ``j`` of a fitted trial stands for (the base's ``q``
+    coefficients first)."""
+    start = q + sum(t.X.shape[1] for t in trial[:j])
+    x = trial[j].X
+    return np.einsum("ij,j->i", x, ev.beta[start:start + x.shape[1]])
+
+
+def _rms_between(simple: tuple[Any, ...], big: tuple[Any, ...], q: int,
+                 m: np.ndarray, effect: str | None = None) -> float:
+    """Rms [N] over the samples ``m`` of what the last term of the trial ``big`` adds
+    beyond the term of ``simple`` (each ``(gain, trial, evaluation, ...)``): its last
+    term, or the one of ``effect``."""
+    ts = simple[1]
+    j = len(ts) - 1 if effect is None else next(
+        i for i, t in enumerate(ts) if t.effect == effect)
+    d = (_contribution(big[1], big[2], len(big[1]) - 1, q)
+         - _contribution(ts, simple[2], j, q))[m]
+    return float(np.sqrt(np.mean(d * d))) if d.size else 0.0
 
 
 def _reprofile(scorer: Scorer, terms: list[Term], cur: Evaluation, ctx: Context
