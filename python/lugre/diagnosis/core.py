@@ -611,12 +611,12 @@ def _diagnose(
         if gone:
             # the named terms judged again as the search judged them, without it
             sel = [t for t in terms_sel if t.effect not in gone]
+            ev_all = scorer.evaluate(sel)
             for k, t in enumerate(terms):
                 j = next((i for i, u in enumerate(sel) if u.effect == t.effect), None)
                 if t.minor or k in noisy or j is None:
                     continue
-                rest = sel[:j] + sel[j + 1:]
-                evj = compare(scorer.evaluate(rest), scorer.evaluate(sel), s2)
+                evj = compare(scorer.evaluate(sel[:j] + sel[j + 1:]), ev_all, s2)
                 if not accept(evj, alpha=alpha, min_gain=min_gain)[0]:
                     beside.add(k)
                     noisy[k] = (f"it passed the held-out test only beside a minor "

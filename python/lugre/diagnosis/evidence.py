@@ -4,6 +4,7 @@ look-alikes."""
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -298,13 +299,8 @@ def _rate_noise_power(sig: Any) -> float:
     """Mean square per sample of the recorded force's noise in its filtered rate of
     change (``sig.dfm``): the white level above the motion's band through the
     residual's low-pass and the central difference; 0 when it cannot be read."""
-    level = R.hf_level(sig.info.get("fm_logged", sig.fm)[sig.mask], sig.fs)
-    if level is None:
-        return 0.0
-    ff, f2 = R.filter_power(sig)
-    d2 = (np.sin(2 * np.pi * ff * sig.dt) / sig.dt) ** 2  # np.gradient's response
-    w = f2 * d2  # (the force is low-passed as the residual is)
-    return float(level * np.sum(0.5 * (w[1:] + w[:-1])) * (ff[1] - ff[0]))
+    # (the force is low-passed as the residual is; np.gradient's power response)
+    return R.force_noise_power(sig, lambda ff: (np.sin(2 * np.pi * ff * sig.dt) / sig.dt) ** 2)
 
 
 def lag_at_reversals(scorer: Scorer, terms: list[Term], k: int, ev: Any,
@@ -344,19 +340,17 @@ def lag_at_reversals(scorer: Scorer, terms: list[Term], k: int, ev: Any,
     # much between them. Both fits are corrected; where the noise is most of the
     # column there, those samples cannot tell
     nn = _rate_noise_power(sig)
+
+    def share(sel: np.ndarray) -> float:  # the noise's share of the column there
+        sxx = float(np.sum(sig.dfm[sel] ** 2))
+        return sel.sum() * nn / sxx if sxx > 0 else 1.0
+
     if nn > 0.0:
-        x = sig.dfm
-        for name, sel in (("full", scorer.mask), ("away", away)):
-            sxx = float(np.sum(x[sel] ** 2))
-            share = sel.sum() * nn / sxx if sxx > 0 else 1.0
-            if share > 0.75:
-                if name == "away":
-                    return None
-                share = 0.75
-            if name == "full":
-                tau = float(tau / (1.0 - share))
-            else:
-                tau_away, se = float(tau_away / (1.0 - share)), float(se / (1.0 - share))
+        s_away = share(away)
+        if s_away > 0.75:
+            return None
+        tau = float(tau / (1.0 - min(share(scorer.mask), 0.75)))
+        tau_away, se = float(tau_away / (1.0 - s_away)), float(se / (1.0 - s_away))
     return {"lag_s": tau, "lag_away_s": tau_away, "se_s": se, "reversals": nrev,
             "reversals_only": bool(se < 0.25 * tau and tau_away < 0.5 * tau
                                    and tau - tau_away > 4.0 * se)}
@@ -540,18 +534,18 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
     found_terms = list(terms or [])
     sig = ctx.sig
 
-    def sizes(Xs: list[np.ndarray]) -> np.ndarray:
+    def sizes(Xs: list[np.ndarray], effect: str) -> np.ndarray:
         # (a minor correction of the same kind, kept in the fit, is part of the effect)
-        rest = [t for t in found_terms if t.cand is None or t.effect != e]
-        floor = max(min_effect * noise_rms, 0.0 if e == "delay" else min_force)
+        rest = [t for t in found_terms if t.cand is None or t.effect != effect]
+        floor = max(min_effect * noise_rms, 0.0 if effect == "delay" else min_force)
         out = revealed_sizes(scorer, rest, Xs, alpha=alpha, min_gain=min_gain,
                              min_rms=floor)
         # a lag under a fifth of the sample interval is a detail of the sampling
         dt = sig.info.get("dt_logged", sig.dt)  # the record's own sample interval
-        return np.maximum(out, 0.2 * dt) if e == "delay" else out
+        return np.maximum(out, 0.2 * dt) if effect == "delay" else out
 
-    def size(X: np.ndarray) -> float:
-        return float(sizes([X])[0])
+    def size(X: np.ndarray, effect: str) -> float:
+        return float(sizes([X], effect)[0])
 
     out: list[dict[str, Any]] = []
     span = ctx.xrange[1] - ctx.xrange[0]
@@ -561,25 +555,25 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
         e = c.effect
         try:
             if e == "offset":
-                b = size(np.ones(len(sig)))
+                b = size(np.ones(len(sig)), e)
                 out.append(_hide(e, b, "N", f"a constant force {_under(b, '{:.2g} N')}", experiment=(
                     "per-direction friction levels absorb a constant force while the axis "
                     "moves; " + EXPERIMENT[("offset", "asymmetry")].split(":")[0]
                     + " separates them")))
             elif e == "spring":
-                b = size(sig.x - np.mean(sig.x[sig.mask]))
+                b = size(sig.x - np.mean(sig.x[sig.mask]), e)
                 out.append(_hide(e, b, "N/m", f"a spring {_under(b, '{:.3g} N/m')}"
                                  + (f" ({b * span:.2g} N over the stroke)" if np.isfinite(b) else "")))
             elif e == "mass":
-                b = size(sig.a)
+                b = size(sig.a, e)
                 out.append(_hide(e, b, "kg", f"a payload {_under(b, '{:.2g} kg')}"))
             elif e == "drag":
-                b = size(sig.filt(np.abs(sig.v) * sig.v))
+                b = size(sig.filt(np.abs(sig.v) * sig.v), e)
                 out.append(_hide(e, b, "N s^2/m^2", f"a drag {_under(b, '{:.3g} N s^2/m^2')}"))
             elif e == "cogging":
                 kmax = c.kmax(ctx)
                 ks = np.geomspace(1.5 / max(span, 1e-9), max(kmax, 2.0 / max(span, 1e-9)), 8)
-                amps = sizes([sig.filt(np.sin(2 * np.pi * k * sig.x)) for k in ks])
+                amps = sizes([sig.filt(np.sin(2 * np.pi * k * sig.x)) for k in ks], e)
                 seen = np.isfinite(amps)
                 b = float(np.max(amps[seen])) if seen.any() else float("inf")
                 blind = ""
@@ -595,19 +589,19 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
                 out.append(_hide(e, b, "N", txt, experiment=(
                     "slow constant-speed passes (a few mm/s) show short pitches")))
             elif e == "delay":
-                b = size(sig.dfm)
+                b = size(sig.dfm, e)
                 out.append(_hide("delay/current_lag", b, "s",
                                  f"a delay or current lag {_under(b * 1e3, '{:.2g} ms')}"))
             elif e == "drift":
-                b = size((sig.t / max(sig.t[-1], 1e-9)) * ctx.fcs)
+                b = size((sig.t / max(sig.t[-1], 1e-9)) * ctx.fcs, e)
                 out.append(_hide(e, b, "-", f"a friction drift {_under(100 * b, '{:.2g} %')} over the "
                                  "record"))
             elif e == "position_friction":
-                b = size(sig.filt(ctx.fcs * (np.abs(sig.x - np.mean(sig.x)) < 0.1 * span)))
+                b = size(sig.filt(ctx.fcs * (np.abs(sig.x - np.mean(sig.x)) < 0.1 * span)), e)
                 out.append(_hide(e, b, "-", f"a friction change {_under(100 * b, '{:.2g} %')} over a "
                                  "tenth of the stroke"))
             elif e in ("stribeck_shape", "deadband", "resonance"):
-                out.append(_nonlinear_hidden(c, ctx, size, sizes))
+                out.append(_nonlinear_hidden(c, ctx, partial(sizes, effect=e)))
         except (ValueError, ArithmeticError, np.linalg.LinAlgError):  # pragma: no cover
             continue
     return [o for o in out if o is not None]
@@ -732,7 +726,9 @@ def _amps(a: float) -> str:
     return f"{a * 1e3:.3g} mA" if abs(a) < 1 else f"{a:.3g} A"
 
 
-def _nonlinear_hidden(c: Any, ctx: Any, size: Any, many: Any) -> dict[str, Any] | None:
+def _nonlinear_hidden(c: Any, ctx: Any, many: Any) -> dict[str, Any] | None:
+    """What the record could hide of a nonlinear effect; ``many(Xs)`` the sizes of
+    columns of it (:func:`revealed_sizes`)."""
     sig = ctx.sig
     if c.effect == "stribeck_shape":
         m = ctx.model
@@ -745,7 +741,7 @@ def _nonlinear_hidden(c: Any, ctx: Any, size: Any, many: Any) -> dict[str, Any] 
             return _hide(c.effect, float("inf"), "-", "the shape of the Stribeck curve (the "
                          "model has no static level above the Coulomb level, fs = fc)",
                          experiment=exp)
-        b = size(c.columns(1.0, ctx)[:, 0])  # exponent 2 -> 1
+        b = float(many([c.columns(1.0, ctx)[:, 0]])[0])  # exponent 2 -> 1
         if not np.isfinite(b) or b > 5:
             return _hide(c.effect, float("inf"), "-", "the shape of the Stribeck curve",
                          experiment=exp)
@@ -753,7 +749,7 @@ def _nonlinear_hidden(c: Any, ctx: Any, size: Any, many: Any) -> dict[str, Any] 
                      experiment=exp if slow < 0.05 else "")
     if c.effect == "deadband":
         d0 = 0.02
-        b = d0 * size(c.columns(d0, ctx)[:, 0])
+        b = d0 * float(many([c.columns(d0, ctx)[:, 0]])[0])
         kf = ctx.model.force_constant
         return _hide(c.effect, b, "A", (f"a dead-band under {_amps(b)} ({b * kf:.2g} N of motor force)"
                      if np.isfinite(b) else "a dead-band of any size"))

@@ -12,6 +12,7 @@ import numpy as np
 from .. import units as U
 from ..html import plain_text
 from ..model import Model
+from .timing import timing_words
 
 __all__ = ["Diagnosis", "Finding"]
 
@@ -197,14 +198,13 @@ class Diagnosis:
         if not self.findings:
             lines.append("Findings: none beyond noise.")
         for k, f in enumerate(self.findings, 1):
-            ps = ", ".join(
-                f"{a} {U.fmt(v, U.unit_of(f.effect, a))}" for a, v in f.parameters.items()
-                if a not in ("positions", "scale")
-            )
             if f.effect in ("delay", "current_lag"):
-                from .timing import timing_words
-
                 ps = timing_words(f.effect, f.parameters)
+            else:
+                ps = ", ".join(
+                    f"{a} {U.fmt(v, U.unit_of(f.effect, a))}" for a, v in f.parameters.items()
+                    if a not in ("positions", "scale")
+                )
             wh = ", ".join(f"{a} {U.fmt_range(v[0], v[1], U.WHERE_UNITS.get(a, ('', 1.0)))}"
                            if isinstance(v, (list, tuple)) and len(v) == 2 else f"{a} {_fmt(v)}"
                            for a, v in f.where.items() if v is not None)
@@ -215,8 +215,6 @@ class Diagnosis:
             for alt in f.alternatives:
                 ap = alt.get("parameters") or {}
                 if alt["effect"] in ("delay", "current_lag"):
-                    from .timing import timing_words
-
                     ap_txt = "(" + timing_words(alt["effect"], {
                         **ap, "seconds": alt.get("effective_delay_s", ap.get("seconds"))}) + ")"
                 else:

@@ -624,6 +624,19 @@ def hf_level(y: np.ndarray, fs: float, gain: Any = None) -> float | None:
     return float(np.median(pb) / (stats.chi2.ppf(0.5, dof) / dof))
 
 
+def force_noise_power(sig: Signals, weight: Any) -> float:
+    """Mean square per sample [N^2] of the recorded force's measurement noise after the
+    residual's low-pass and a further power gain ``weight(f)``: the white level above
+    the motion's band (:func:`hf_level`) through both; 0 when the level cannot be
+    read."""
+    level = hf_level(sig.info.get("fm_logged", sig.fm)[sig.mask], sig.fs)
+    if level is None:
+        return 0.0
+    ff, f2 = filter_power(sig)
+    w = f2 * weight(ff)
+    return float(level * np.sum(0.5 * (w[1:] + w[:-1])) * (ff[1] - ff[0]))
+
+
 def filter_power(sig: Signals) -> tuple[np.ndarray, np.ndarray]:
     """Frequencies 0 to Nyquist (4001 points) and the power gain of the residual's
     zero-phase low-pass there (``|H|^4``: squared magnitude, applied twice)."""

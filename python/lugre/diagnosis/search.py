@@ -590,16 +590,22 @@ def accept(ev: dict[str, float], *, alpha: float, min_gain: float) -> tuple[bool
         return False, "gain below threshold"
     if ev["p"] < alpha:
         return True, "consistent over blocks"
-    if ev["gain"] > 20 * min_gain and ev["positive"] >= 3 and ev["ratio"] > 10:
+    if _overwhelming(ev["gain"], ev["positive"], ev["ratio"], min_gain):
         return True, "confined but overwhelming"
     return False, (f"not consistent over held-out blocks (gains in {ev['positive']} "
                    f"blocks, p = {ev['p']:.2g})")
 
 
+def _overwhelming(gain: Any, positive: Any, ratio: Any, min_gain: float) -> Any:
+    """:func:`accept`'s route for a confined mismatch (scalars or arrays alike)."""
+    return (gain > 20 * min_gain) & (positive >= 3) & (ratio > 10)
+
+
 def accept_many(d: np.ndarray, gain: np.ndarray, *, alpha: float,
                 min_gain: float) -> np.ndarray:
     """:func:`accept`'s decision for many sets of per-block gains at once: ``d``
-    ``(m, K)``, their score gains ``gain`` ``(m,)``; a boolean ``(m,)``."""
+    ``(m, K)``, their score gains ``gain`` ``(m,)``; a boolean ``(m,)``. The block
+    statistics are :func:`block_evidence`'s, along the last axis."""
     d = np.atleast_2d(d)
     K = d.shape[-1]
     sd = np.std(d, axis=-1, ddof=1)
@@ -613,8 +619,7 @@ def accept_many(d: np.ndarray, gain: np.ndarray, *, alpha: float,
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(neg > 0, pos / neg, np.inf)
     npos = np.sum(d > 0, axis=-1)
-    return (gain > min_gain) & ((p < alpha) | ((gain > 20 * min_gain) & (npos >= 3)
-                                                & (ratio > 10)))
+    return (gain > min_gain) & ((p < alpha) | _overwhelming(gain, npos, ratio, min_gain))
 
 
 def _pair(scorer: Scorer, terms: list[Term], cur: Evaluation, strong: list[tuple[Any, ...]],
@@ -711,6 +716,7 @@ def forward_select(
     q = scorer.J.shape[1]
     dt = ctx.sig.info.get("dt_logged", ctx.sig.dt)  # the record's own sample interval
     m = scorer.mask
+    practical = max(min_force, min_effect * noise_rms)  # a finding's force at least
     while sum(not t.minor for t in terms) < max_terms and len(terms) < max_terms + 4:
         step += 1
         chosen = {t.effect for t in terms}
@@ -814,8 +820,7 @@ def forward_select(
         # (and when it would replace the simpler one already found, add a force of
         # practical size beyond it, or the search goes on without it)
         held = [s_ for s_ in (bc[4].supersedes if bc else ()) if s_ in chosen]
-        if held and _rms_between((None, terms, cur), best, q, m, held[0]) < max(
-                min_force, min_effect * noise_rms):
+        if held and _rms_between((None, terms, cur), best, q, m, held[0]) < practical:
             log[best[3]]["ok"] = False
             log[best[3]]["why"] += (f"; not taken: beyond the {held[0]} found it adds a "
                                     "force under the practical size (parsimony)")
@@ -829,15 +834,14 @@ def forward_select(
                 # 171 m on a 0.15 m stroke: 0.003 N of slope, bought by a small mass
                 # error the sines' positions follow)
                 extra = _rms_between(okays[simple], best, q, m)
-                if (not accept(nested, alpha=alpha, min_gain=min_gain)[0]
-                        or extra < max(min_force, min_effect * noise_rms)):
-                    best = okays[simple][:4]
-                    log[best[3]]["why"] += ("; preferred to a term containing it, which "
-                                            "does not pass the test against it (parsimony)"
-                                            if extra >= max(min_force, min_effect * noise_rms)
-                                            else "; preferred to a term containing it, "
-                                            f"which adds {extra:.2g} N rms beyond it: under "
-                                            "the practical size (parsimony)")
+                if not accept(nested, alpha=alpha, min_gain=min_gain)[0]:
+                    why = "does not pass the test against it"
+                elif extra < practical:
+                    why = f"adds {extra:.2g} N rms beyond it: under the practical size"
+                else:
+                    continue
+                best = okays[simple][:4]
+                log[best[3]]["why"] += f"; preferred to a term containing it, which {why} (parsimony)"
         _, terms, cur, li = best
         log[li]["accepted"] = True
         terms, cur = _reprofile(scorer, terms, cur, ctx)

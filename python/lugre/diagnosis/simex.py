@@ -52,7 +52,7 @@ SURROGATE_SEED = 20_240_611
 NOISE_SHARE = 0.5
 
 
-def surrogates(rec: Recording, model: Model, sig: R.Signals, scale: float = 1.0
+def surrogates(rec: Recording, model: Model, sig: R.Signals
                ) -> list[R.Signals]:
     """The record with noise like its own added, and subtracted, prepared as ``sig``
     (same band and time origin): ``[sig(+e), sig(-e)]``; empty when the record is too
@@ -76,7 +76,6 @@ def surrogates(rec: Recording, model: Model, sig: R.Signals, scale: float = 1.0
     ef = np.sqrt(sf * 0.5 * fs) * rng.standard_normal(x.size)
     backend = "reference" if sig.backend.__name__.endswith("reference") else "core"
     out = []
-    ex, ef = scale * ex, scale * ef  # (scale^2 times the record's noise variance)
     for sgn in (1.0, -1.0):
         r = Recording(t=rec.t, x=x + sgn * ex, F=force + sgn * ef)
         out.append(R.prepare(r, model, cutoff_hz=sig.cutoff_hz, backend=backend))

@@ -82,13 +82,9 @@ def smoothing_gain(sig: R.Signals, bandwidth: float, n: int, s2: float) -> float
     """
     if bandwidth <= 0:
         return 0.0
-    level = R.hf_level(sig.info.get("fm_logged", sig.fm)[sig.mask], sig.fs)
-    if level is None:
-        return 0.0
-    ff, f2 = R.filter_power(sig)
-    w = f2 * (ff / bandwidth) ** 2 / (1.0 + (ff / bandwidth) ** 2)
-    integral = float(np.sum(0.5 * (w[1:] + w[:-1])) * (ff[1] - ff[0]))
-    return n * level * integral / s2
+    power = R.force_noise_power(
+        sig, lambda ff: (ff / bandwidth) ** 2 / (1.0 + (ff / bandwidth) ** 2))
+    return n * power / s2
 
 
 def choose_timing(model: Model, sig: R.Signals, terms: list[Term], k: int,
