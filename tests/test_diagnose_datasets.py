@@ -62,17 +62,45 @@ def test_mismatch_case(case):
             assert lo < e["generated_as"]["center"] < hi
 
 
-@pytest.mark.skipif(not EMPS.is_file(), reason=f"EMPS record not found at {EMPS}")
-def test_emps_laps():
+@pytest.fixture(scope="module")
+def emps_laps():
+    if not EMPS.is_file():
+        pytest.skip(f"EMPS record not found at {EMPS}")
     rec = lugre.read_recording(EMPS)
     fit_part, check = rec.slice((None, 12.42)), rec.slice((12.42, None))
     base = fit_inverse_dynamics(fit_part)
+    return fit_part, check, base, diagnose(fit_part, base, holdout=check)
+
+
+def test_emps_laps(emps_laps):
+    _, _, base, dg = emps_laps
     assert base.mass == pytest.approx(95.1, rel=0.05)
-    dg = diagnose(fit_part, base, holdout=check)
     before = dg.fit["holdout_before"]["nrmse_force"]
     after = dg.fit["holdout_after"]["nrmse_force"]
     assert before < 0.0408  # per-direction LuGre base beats the symmetric benchmark model
     assert after <= before
+
+
+PULSES = SHARED / "datasets" / "emps" / "emps_validation_pulses.csv"
+
+
+@pytest.mark.skipif(not PULSES.is_file(), reason=f"EMPS pulses record not found at {PULSES}")
+def test_emps_model_questioned_on_another_session(emps_laps):
+    # the augmented model of laps 1-2 keeps every effect on laps 3-4 (recorded right
+    # after); on the pulses record, another session, its 2.5 mm cogging sits 0.7 mm
+    # (1.76 rad) away: it is removed and found again at its pitch, with the reason said
+    _, check, _, dg = emps_laps
+    aug = dg.augmented_model()
+    assert "cogging" in {e["effect"] for e in aug.effects}
+    laps = diagnose(check, aug, closed_loop=False)
+    assert laps.removed == []
+    pulses = diagnose(lugre.read_recording(PULSES), aug, closed_loop=False)
+    assert [r["effect"] for r in pulses.removed] == ["cogging"]
+    cog = next(f for f in pulses.findings if f.effect == "cogging")
+    assert cog.parameters["pitch"] == pytest.approx(0.0025, rel=0.01)
+    assert 0.6 < cog.parameters["amplitude"] < 1.1
+    assert any("position origin likely differs" in n for n in pulses.notes)
+    assert pulses.fit["after"]["nrmse_force"] < 0.8 * pulses.fit["before"]["nrmse_force"]
 
 
 def test_clean_record_holds_the_presliding_parameters():
@@ -108,3 +136,28 @@ def test_diagnosing_the_augmented_model_again(case):
     assert again.findings == [], again.summary()
     assert any("already holds its" in n for n in again.notes)
     assert case not in {h["effect"] for h in again.could_not_reveal}
+
+
+@pytest.mark.parametrize("case", ["none", "cogging", "position_friction", "deadband", "drag",
+                                  "stribeck_shape", "resonance"])
+def test_a_wrong_effect_in_the_model_is_removed(case):
+    # the independent plant's records, the model given an effect the axis lacks (8 % of
+    # the Coulomb level: a cogging at a seventh of the stroke, or a spring where the
+    # record's cogging is): it is removed and what the record holds is named as before
+    import numpy as np
+
+    d = MISMATCH / case
+    truth = [e["effect"] for e in json.loads((d / "truth.json").read_text())["effects"]]
+    rec = lugre.read_recording(d / "recording.csv")
+    md = lugre.load_model(d / "model.json").to_dict()
+    fc = 0.5 * (md["friction"]["positive"]["fc"] + md["friction"]["negative"]["fc"])
+    x = np.asarray(rec.x)
+    stroke, mid = float(np.ptp(x)), float(0.5 * (x.max() + x.min()))
+    wrong = ({"effect": "spring", "stiffness": 0.08 * fc / (0.5 * stroke), "x0": mid}
+             if "cogging" in truth else
+             {"effect": "cogging", "amplitude": 0.08 * fc, "pitch": stroke / 7.3, "phase": 1.0})
+    md["effects"] = [wrong]
+    dg = diagnose(rec, lugre.Model.from_dict(md), closed_loop=False)
+    assert [r["effect"] for r in dg.removed] == [wrong["effect"]]
+    assert [f.effect for f in dg.findings] == truth
+    assert wrong not in dg.augmented.effects

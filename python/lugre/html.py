@@ -284,7 +284,7 @@ def _verdict(report: dict[str, Any]) -> tuple[str, bool]:
     """The verdict paragraph (the report's own when it has one) and whether all is well."""
     findings = report.get("findings") or []
     fit = report.get("fit") or {}
-    ok = not findings and not report.get("unexplained")
+    ok = not findings and not report.get("unexplained") and not report.get("removed")
     if report.get("verdict"):
         return str(report["verdict"]), ok
     hold = fit.get("holdout_before") and fit.get("holdout_after")
@@ -494,6 +494,19 @@ def diagnosis_page(report: dict[str, Any], data: dict[str, Any] | None = None, *
         body.append(_p("No effect beyond noise was found."))
     for k, f in enumerate(findings, 1):
         body.append(_finding_section(k, f, data, floor))
+
+    removed = [r for r in (report.get("removed") or []) if isinstance(r, dict)]
+    if removed:
+        body.append("<h2>Removed from the model</h2>")
+        body.append(_p("Effects of the model as given that this record contradicts: the "
+                       "augmented model leaves them out."))
+        rows = [[escape(_effect_title(str(r.get("effect")))),
+                 escape(", ".join(f"{k} {v:.4g}" if isinstance(v, (int, float)) else f"{k} {v}"
+                                  for k, v in (r.get("parameters") or {}).items()
+                                  if not isinstance(v, list))),
+                 escape(str(r.get("evidence", "")))]
+                for r in removed]
+        body.append(_table(["effect", "parameters as given", "why"], rows))
 
     body.append("<h2>Held-out gain</h2>")
     hg = _gain(fit.get("holdout_before"), fit.get("holdout_after"))

@@ -792,8 +792,25 @@ def verdict(dg: Any) -> str:
                      "model as given, and check this record against the held-out one "
                      "(an unstable or saturated stretch, another setup or temperature) "
                      "before using the augmented model.")
+    gone = getattr(dg, "removed", [])
+    if not gone:
+        return _verdict_findings(dg, gain)
+    # the model's own effects that the record contradicts come first: they are what the
+    # user wrote, and the augmented model leaves them out
+    one = len(gone) == 1
+    names = ", ".join(f"its {r['effect'].replace('_', ' ')} "
+                      f"({effect_words(r['effect'], r['parameters'])})" for r in gone)
+    return (f"The model as given holds what this record contradicts: {names}; "
+            f"{'it is' if one else 'they are'} left out of the augmented model. "
+            + _verdict_findings(dg, gain, f"without {'it' if one else 'them'}"))
+
+
+def _verdict_findings(dg: Any, gain: str, without: str = "") -> str:
     if not dg.findings:
-        txt = "Nothing found: the model leaves nothing out that this record can show."
+        txt = ("Nothing found: the model leaves nothing out that this record can show."
+               if not without else
+               f"Nothing else found: the model {without} leaves nothing out that this "
+               "record can show.")
         if dg.base_moves:
             txt = ("No missing physics found, but the model's base parameters are off: "
                    + "; ".join(m["text"] for m in dg.base_moves) + ".")
@@ -813,21 +830,26 @@ def verdict(dg: Any) -> str:
 
 
 def _params(f: Any) -> str:
+    return effect_words(f.effect, f.parameters)
+
+
+def effect_words(effect: str, parameters: dict[str, Any]) -> str:
+    """An effect's parameters in a few words with their units ("amplitude 1 N, ...")."""
     units = {"amplitude": "N", "pitch": "m", "phase": "rad", "stiffness": "N/m", "x0": "m",
              "force": "N", "delta": "kg", "seconds": "s", "bandwidth": "Hz",
              "gain": "", "time_constant": "s", "frequency": "Hz", "damping_ratio": "",
              "load_fraction": "", "current": "A", "coefficient": "N s^2/m^2",
              "exponent": ""}
-    if f.effect in ("delay", "current_lag"):
+    if effect in ("delay", "current_lag"):
         from .timing import timing_words
 
-        return timing_words(f.effect, f.parameters)
+        return timing_words(effect, parameters)
     parts = []
-    for k, v in f.parameters.items():
+    for k, v in parameters.items():
         if isinstance(v, (int, float)):
             parts.append(f"{k} {v:.3g}{' ' + units.get(k, '') if units.get(k) else ''}")
-    if f.effect == "position_friction":
-        sc = np.asarray(f.parameters["scale"])
+    if effect == "position_friction" and parameters.get("scale"):
+        sc = np.asarray(parameters["scale"])
         j = int(np.argmax(np.abs(sc - 1)))
-        parts.append(f"level x{sc[j]:.3g} at x = {f.parameters['positions'][j]:.3g} m")
+        parts.append(f"level x{sc[j]:.3g} at x = {parameters['positions'][j]:.3g} m")
     return ", ".join(parts)

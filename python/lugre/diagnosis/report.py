@@ -135,6 +135,9 @@ class Diagnosis:
     #: kept in the augmented model (so that they do not leak into the findings), not
     #: named; each ``effect``, ``parameters``, ``rms_force`` [N]
     minor: list[dict[str, Any]] = field(default_factory=list)
+    #: effects of the model as given that the record contradicts: left out of the
+    #: augmented model; each ``effect``, ``parameters``, ``evidence`` and the block test
+    removed: list[dict[str, Any]] = field(default_factory=list)
 
     def augmented_model(self) -> Model:
         """The model with the findings added to ``effects`` and the base re-estimated."""
@@ -154,6 +157,7 @@ class Diagnosis:
             "base_moves": _plain(self.base_moves),
             "could_not_reveal": _plain(self.could_not_reveal),
             "minor": _plain(self.minor),
+            "removed": _plain(self.removed),
             "trials": [
                 {k: _plain(v) for k, v in t.items() if k in (
                     "step", "effect", "gain", "p", "positive", "contrib", "accepted", "why")}
@@ -195,6 +199,8 @@ class Diagnosis:
                 f"{cl['after']['rms_position'] * 1e6:.3g} um rms, current "
                 f"{cl['before']['rms_current']:.3g} A -> {cl['after']['rms_current']:.3g} A rms."
             )
+        for r in self.removed:
+            lines.append(f"Removed from the model: {r['effect']}. {plain_text(r['evidence'])}")
         if not self.findings:
             lines.append("Findings: none beyond noise.")
         for k, f in enumerate(self.findings, 1):
