@@ -866,3 +866,23 @@ def test_the_models_right_effects_are_kept(scale):
         (f,) = dg.findings
         assert f.effect == "cogging"
         assert f.parameters["amplitude"] == pytest.approx(1.0, rel=0.1)
+
+
+@pytest.mark.parametrize("given", [{"effect": "delay", "seconds": 0.0003},
+                                   {"effect": "current_lag", "bandwidth": 400.0}])
+def test_a_wrong_timing_in_the_model_is_replaced(given):
+    # one of a kind: the timing term is not searched beside the model's own. A 0.3 ms
+    # delay (or a 400 Hz lag) given where the drive has a 1 ms dead time was kept as
+    # given and the rest went unexplained; searched again without it, the record's own
+    # replaces it. The right one given is kept
+    rec, believed, _ = concealed({"effect": "delay", "seconds": 0.001}, duration=10.0)
+    dg = diagnose(rec, _with_effects(believed, [given]), closed_loop=False)
+    assert [(r["effect"], r.get("replaced")) for r in dg.removed] == [(given["effect"], True)]
+    (f,) = dg.findings
+    assert f.effect == "delay"
+    assert f.parameters["seconds"] == pytest.approx(0.001, rel=0.1)
+    assert "does not match this record: searched again without it" in dg.verdict
+    assert "Replaced in the model: " + given["effect"] in dg.summary()
+    right = diagnose(rec, _with_effects(believed, [{"effect": "delay", "seconds": 0.001}]),
+                     closed_loop=False)
+    assert right.removed == [] and right.findings == []

@@ -88,14 +88,19 @@ PULSES = SHARED / "datasets" / "emps" / "emps_validation_pulses.csv"
 def test_emps_model_questioned_on_another_session(emps_laps):
     # the augmented model of laps 1-2 keeps every effect on laps 3-4 (recorded right
     # after); on the pulses record, another session, its 2.5 mm cogging sits 0.7 mm
-    # (1.76 rad) away: it is removed and found again at its pitch, with the reason said
+    # (1.76 rad) away: it is removed and found again at its pitch, with the reason
+    # said; its delay (0.57 ms) is searched again and replaced (0.74-0.76 ms there)
     _, check, _, dg = emps_laps
     aug = dg.augmented_model()
-    assert "cogging" in {e["effect"] for e in aug.effects}
+    assert {"cogging", "delay"} <= {e["effect"] for e in aug.effects}
     laps = diagnose(check, aug, closed_loop=False)
     assert laps.removed == []
     pulses = diagnose(lugre.read_recording(PULSES), aug, closed_loop=False)
-    assert [r["effect"] for r in pulses.removed] == ["cogging"]
+    gone = {r["effect"]: r for r in pulses.removed}
+    assert set(gone) == {"cogging", "delay"}
+    assert gone["delay"].get("replaced") and not gone["cogging"].get("replaced")
+    timing = next(f for f in pulses.findings if f.effect in ("delay", "current_lag"))
+    assert 0.00065 < timing.parameters["seconds"] < 0.00085
     cog = next(f for f in pulses.findings if f.effect == "cogging")
     assert cog.parameters["pitch"] == pytest.approx(0.0025, rel=0.01)
     assert 0.6 < cog.parameters["amplitude"] < 1.1
@@ -161,3 +166,24 @@ def test_a_wrong_effect_in_the_model_is_removed(case):
     assert [r["effect"] for r in dg.removed] == [wrong["effect"]]
     assert [f.effect for f in dg.findings] == truth
     assert wrong not in dg.augmented.effects
+
+
+@pytest.mark.parametrize("frequency,load,replaced", [(30.0, 0.75, True), (22.0, 0.5, True),
+                                                     (22.0, 0.75, False)])
+def test_a_resonance_in_the_model_is_searched_again(frequency, load, replaced):
+    # the independent plant's 22 Hz coupling on 75 % of the mass: a model holding one at
+    # 30 Hz, or on half the mass, has it replaced by the one the record holds; the
+    # right one given is kept
+    d = MISMATCH / "resonance"
+    md = lugre.load_model(d / "model.json").to_dict()
+    md["effects"] = [{"effect": "resonance", "frequency": frequency, "damping_ratio": 0.04,
+                      "load_fraction": load}]
+    dg = diagnose(lugre.read_recording(d / "recording.csv"), lugre.Model.from_dict(md),
+                  closed_loop=False)
+    if not replaced:
+        assert dg.removed == [] and dg.findings == []
+        return
+    assert [(r["effect"], r.get("replaced")) for r in dg.removed] == [("resonance", True)]
+    (f,) = dg.findings
+    assert f.parameters["frequency"] == pytest.approx(22.0, rel=0.1)
+    assert f.parameters["load_fraction"] == pytest.approx(0.75, abs=0.1)

@@ -306,9 +306,11 @@ def _diagnose(
     tolerance: float = 1.0,
     backend: str = "core",
     _given: tuple[Model, list[dict[str, Any]]] | None = None,
+    _question: bool = True,
 ) -> Diagnosis:
     """:func:`diagnose` without its warnings' filter. ``_given``: the model as the user
-    gave it and its effects removed so far, when ``model`` is that model without them."""
+    gave it and its effects removed so far, when ``model`` is that model without them;
+    ``_question``: question the model's own effects (not in a search for one kind)."""
     rec = as_recording(recording)
     model = _as_model(model)
     # 1. prepare: checks, filtered signals, the residual of the model as given
@@ -330,9 +332,52 @@ def _diagnose(
     if _given is not None:
         model_given, removed = _given[0], list(_given[1])
         r0_given = R.residual(model_given, sig)
-    model, contradicted = question_effects(model, sig, r0, blocks=blocks, alpha=alpha,
-                                           min_gain=min_gain, step=step,
-                                           tolerance=tolerance)
+    contradicted: list[dict[str, Any]] = []
+    if _question and model.effects:
+        model, contradicted = question_effects(model, sig, r0, blocks=blocks, alpha=alpha,
+                                               min_gain=min_gain, step=step,
+                                               tolerance=tolerance)
+        # one of a kind (a timing term, a resonance, a Stribeck shape) is not searched
+        # beside the model's own: the record is searched for that kind again without
+        # it, and the one it finds replaces the model's when it predicts the held-out
+        # stretches better (a delay given from another session; a resonance moved)
+        for k, e in reversed(list(enumerate(model.effects))):
+            kind = "delay" if e["effect"] in ("delay", "current_lag") else str(e["effect"])
+            if kind not in ("delay", "resonance", "stribeck_shape"):
+                continue
+            m_k = _without(model, {k})
+            try:
+                sub = _diagnose(rec, m_k, cutoff_hz=cutoff_hz, blocks=blocks, alpha=alpha,
+                                min_gain=min_gain, closed_loop=False, candidates=[kind],
+                                screw_lead=screw_lead, tolerance=tolerance,
+                                backend=backend, _question=False)
+            except ValueError:
+                continue
+            again = [f for f in sub.findings
+                     if ("delay" if f.effect == "current_lag" else f.effect) == kind]
+            if not again:
+                continue
+            # the model with the one found in place of its own, all else as given: the
+            # comparison is of the two alone (the search's refit of the friction levels
+            # is no part of it)
+            found = [x for x in sub.augmented.effects[len(m_k.effects):]
+                     if ("delay" if x["effect"] == "current_lag" else x["effect"]) == kind]
+            d_sub = m_k.to_dict()
+            d_sub["effects"] = list(d_sub["effects"]) + found[:1]
+            try:
+                r_sub = R.residual(Model.from_dict(d_sub), sig)
+            except ValueError:
+                continue
+            res = _removals(model, sig, R.residual(model, sig), [], blocks=blocks,
+                            step=step, tolerance=tolerance, others=[r_sub])
+            pt = res[0][0] if res and res[0] is not None else None
+            if pt is None or not accept(pt, alpha=alpha, min_gain=min_gain)[0]:
+                continue
+            f = again[0]
+            contradicted.append(_removed_entry(
+                e, pt, accept(pt, alpha=alpha, min_gain=min_gain)[1],
+                instead=f"{f.effect.replace('_', ' ')} ({V.effect_words(f.effect, f.parameters)})"))
+            model = m_k
     if contradicted:
         removed += contradicted
         r0 = R.residual(model, sig)
@@ -682,7 +727,7 @@ def _diagnose(
     # contradicts now (or one a finding of its kind only cancels) goes, and the record
     # is diagnosed again without it
     r1 = R.residual(aug, sig)
-    if model.effects:
+    if _question and model.effects:
         later = contradicted_beside(aug, len(model.effects), sig, r1, blocks=blocks,
                                     alpha=alpha, min_gain=min_gain, step=step,
                                     tolerance=tolerance)
@@ -878,12 +923,14 @@ def _without(model: Model, drop: set[int]) -> Model:
 
 
 def _removals(model: Model, sig: R.Signals, r: np.ndarray, sets: list[set[int]], *,
-              blocks: int, step: int, tolerance: float
-              ) -> list[tuple[dict[str, Any], dict[str, Any], Model] | None]:
+              blocks: int, step: int, tolerance: float,
+              others: list[np.ndarray] | None = None
+              ) -> list[tuple[dict[str, Any], dict[str, Any], Model | None] | None]:
     """Held-out evidence of taking each set of ``model``'s effects out: per set, the
     gain of removing it and the gain of keeping it (:func:`compare`, the friction levels
     refitted in both), and the model without it; ``None`` where no valid model is left.
-    ``r`` is ``model``'s residual."""
+    ``r`` is ``model``'s residual; ``others``: residuals of other models, judged the
+    same way (after the sets, without a model)."""
     n_used = int(sig.mask.sum())
     J, _, _, tol = B.base_jacobian(model, sig, names=B.LEVELS)
     tol = tol * float(tolerance)
@@ -908,11 +955,17 @@ def _removals(model: Model, sig: R.Signals, r: np.ndarray, sets: list[set[int]],
             continue
         ev_s = sc.like(r=r_s).evaluate([])
         out.append((compare(ev, ev_s, s2), compare(ev_s, ev, s2), m_s))
+    for r_o in others or []:
+        if not np.all(np.isfinite(r_o[sig.mask])):
+            out.append(None)
+            continue
+        ev_o = sc.like(r=r_o).evaluate([])
+        out.append((compare(ev, ev_o, s2), compare(ev_o, ev, s2), None))
     return out
 
 
 def _removed_entry(e: dict[str, Any], pt: dict[str, Any], why: str, *,
-                   beside: str = "") -> dict[str, Any]:
+                   beside: str = "", instead: str = "") -> dict[str, Any]:
     e = dict(e)
     name = str(e.pop("effect"))
     words = V.effect_words(name, e)
@@ -920,6 +973,15 @@ def _removed_entry(e: dict[str, Any], pt: dict[str, Any], why: str, *,
            "by far, where the mismatch lies")
     said = (f"The model's {name.replace('_', ' ')}{' (' + words + ')' if words else ''} "
             "does not match this record: ")
+    if instead:
+        said += (f"searched again without it, this record holds {instead}, which predicts "
+                 f"the held-out stretches better {how} (in {pt['positive']} of "
+                 f"{pt['blocks']}, by {pt['gain']:.0f} in squared-error units of the noise; "
+                 f"chance of this from noise alone: p = {pt['p']:.2g}). It is replaced: "
+                 "the augmented model holds the one found.")
+        return {"effect": name, "parameters": e, "evidence": said, "gain": pt["gain"],
+                "p": pt["p"], "positive": pt["positive"], "blocks": pt["blocks"],
+                "replaced": True}
     if beside:
         said += (f"the search found {beside} of the opposite sense beside it, and the two "
                  "together do not earn their place on the held-out stretches (kept: "

@@ -797,12 +797,25 @@ def verdict(dg: Any) -> str:
         return _verdict_findings(dg, gain)
     # the model's own effects that the record contradicts come first: they are what the
     # user wrote, and the augmented model leaves them out
+    def listed(rs: list[dict[str, Any]], who: str = "its") -> str:
+        return ", ".join(f"{who} {r['effect'].replace('_', ' ')} "
+                         f"({effect_words(r['effect'], r['parameters'])})" for r in rs)
+
+    out = []
+    left = [r for r in gone if not r.get("replaced")]
+    swapped = [r for r in gone if r.get("replaced")]
+    if left:
+        out.append(f"The model as given holds what this record contradicts: {listed(left)}; "
+                   f"{'it is' if len(left) == 1 else 'they are'} left out of the augmented "
+                   "model.")
+    if swapped:
+        out.append(f"{listed(swapped, 'The model' + chr(39) + 's')} "
+                   f"{'does' if len(swapped) == 1 else 'do'} not match this record: searched "
+                   "again without it, the record holds another of its kind (below), which "
+                   "replaces it.")
     one = len(gone) == 1
-    names = ", ".join(f"its {r['effect'].replace('_', ' ')} "
-                      f"({effect_words(r['effect'], r['parameters'])})" for r in gone)
-    return (f"The model as given holds what this record contradicts: {names}; "
-            f"{'it is' if one else 'they are'} left out of the augmented model. "
-            + _verdict_findings(dg, gain, f"without {'it' if one else 'them'}"))
+    return " ".join(out) + " " + _verdict_findings(dg, gain,
+                                                   f"without {'it' if one else 'them'}")
 
 
 def _verdict_findings(dg: Any, gain: str, without: str = "") -> str:

@@ -200,7 +200,8 @@ class Diagnosis:
                 f"{cl['before']['rms_current']:.3g} A -> {cl['after']['rms_current']:.3g} A rms."
             )
         for r in self.removed:
-            lines.append(f"Removed from the model: {r['effect']}. {plain_text(r['evidence'])}")
+            what = "Replaced in the model" if r.get("replaced") else "Removed from the model"
+            lines.append(f"{what}: {r['effect']}. {plain_text(r['evidence'])}")
         if not self.findings:
             lines.append("Findings: none beyond noise.")
         for k, f in enumerate(self.findings, 1):
