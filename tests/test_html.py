@@ -52,6 +52,9 @@ def hand_built() -> tuple[dict, dict]:
         "unexplained": {"message": "a 3 N burst stays unexplained.",
                         "where": {"time": [3.0, 3.5], "position": None, "velocity": None}},
         "notes": ["sigma1 is poorly determined by this record."],
+        "removed": [{"effect": "spring", "parameters": {"stiffness": 5.0, "x0": 0.0},
+                     "evidence": "The model's spring does not match this record.",
+                     "gain": 220.0, "p": 1e-4, "positive": 9, "blocks": 10}],
     }
     data = {"effects": [{"x": x, "residual": effect + 0.3 * rng.standard_normal(x.size),
                          "effect": effect, "xlabel": "position [m]"}]}
@@ -83,6 +86,9 @@ def test_hand_built_report_renders_every_optional_key():
     assert page.count("data:image/png;base64,") == 1  # the finding's own figure
     assert "chi-square" not in text and "score by" not in text
     assert "9 of 10 stretches" in text
+    assert text.index("Removed from the model") < text.index("Held-out gain")
+    assert "spring does not match this record." in text
+    assert "stiffness 5" in text
 
 
 def test_shares_add_up_to_one_hundred():

@@ -376,7 +376,8 @@ def _diagnose(
             f = again[0]
             contradicted.append(_removed_entry(
                 e, pt, accept(pt, alpha=alpha, min_gain=min_gain)[1],
-                instead=f"{f.effect.replace('_', ' ')} ({V.effect_words(f.effect, f.parameters)})"))
+                instead=f"{f.effect.replace('_', ' ')} ({V.effect_words(f.effect, f.parameters)})",
+                moved=_moved(e, f.parameters) if f.effect == e["effect"] else ""))
             model = m_k
     if contradicted:
         removed += contradicted
@@ -964,8 +965,23 @@ def _removals(model: Model, sig: R.Signals, r: np.ndarray, sets: list[set[int]],
     return out
 
 
+def _moved(old: dict[str, Any], new: dict[str, Any]) -> str:
+    """What moved between two effects of a kind, in words ("damping_ratio 0.18 -> 0.3;
+    frequency, load_fraction within 5 %")."""
+    moved, same = [], []
+    for k, v in new.items():
+        w = old.get(k)
+        if not isinstance(v, (int, float)) or not isinstance(w, (int, float)):
+            continue
+        if abs(v - w) > 0.05 * max(abs(v), abs(w)):
+            moved.append(f"{k} {w:.3g} -> {v:.3g}")
+        else:
+            same.append(k)
+    return "; ".join(moved) + (f"; {', '.join(same)} within 5 %" if moved and same else "")
+
+
 def _removed_entry(e: dict[str, Any], pt: dict[str, Any], why: str, *,
-                   beside: str = "", instead: str = "") -> dict[str, Any]:
+                   beside: str = "", instead: str = "", moved: str = "") -> dict[str, Any]:
     e = dict(e)
     name = str(e.pop("effect"))
     words = V.effect_words(name, e)
@@ -978,7 +994,8 @@ def _removed_entry(e: dict[str, Any], pt: dict[str, Any], why: str, *,
                  f"the held-out stretches better {how} (in {pt['positive']} of "
                  f"{pt['blocks']}, by {pt['gain']:.0f} in squared-error units of the noise; "
                  f"chance of this from noise alone: p = {pt['p']:.2g}). It is replaced: "
-                 "the augmented model holds the one found.")
+                 "the augmented model holds the one found."
+                 + (f" What moved: {moved}." if moved else ""))
         return {"effect": name, "parameters": e, "evidence": said, "gain": pt["gain"],
                 "p": pt["p"], "positive": pt["positive"], "blocks": pt["blocks"],
                 "replaced": True}
