@@ -79,6 +79,10 @@ def test_emps_laps(emps_laps):
     after = dg.fit["holdout_after"]["nrmse_force"]
     assert before < 0.0408  # per-direction LuGre base beats the symmetric benchmark model
     assert after <= before
+    # what stays is at standstill and creeping speeds (a few % of the time holds over a
+    # third of it): said where it lives, with the test that measures it
+    shape = " ".join(dg.unexplained["shape"])
+    assert "stands or moves under" in shape and "slow current ramp at standstill" in shape
 
 
 PULSES = SHARED / "datasets" / "emps" / "emps_validation_pulses.csv"

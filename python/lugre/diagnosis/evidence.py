@@ -490,13 +490,37 @@ def unexplained(r: np.ndarray, sig: R.Signals, floor: float, where: dict[str, An
             "payload, which is the same mass both ways, but a force that grows with the "
             "force the drive transmits, e.g. friction of a preloaded nut or of a guide "
             "loaded by the drive")
+    at_reversals = lag_rev is not None
     if lag_rev is None and rev.any() and share_rev > 2.0 * rev.mean() and share_rev > 0.3:
+        at_reversals = True
         shape.append(
             f"{100 * share_rev:.0f} % of the rest lies within 50 ms of the {nrev} "
             f"reversals ({100 * rev.mean():.0f} % of the time): a force step or lost motion "
             "at each change of direction, e.g. backlash between motor and load, or a "
             "presliding stage the model does not hold")
     d = where.get("direction", {})
+    # concentrated at low speed (and not already said of the reversals, where the speed
+    # is low too): the smallest share of the top speed under which a third of the rest
+    # lies, in at most a quarter of the time's share
+    if not at_reversals:
+        vv = np.abs(sig.vf[m])
+        vtop = float(vv.max()) if vv.size else 0.0
+        tot = max(float(np.sum(rr ** 2)), 1e-300)
+        for frac in (0.01, 0.02, 0.05, 0.1):
+            slow = vv <= frac * vtop
+            share_slow = float(np.sum(rr[slow] ** 2)) / tot
+            if slow.sum() > 20 and share_slow > 0.3 and share_slow > 4.0 * float(slow.mean()):
+                fast = float(np.sqrt(np.mean(rr[~slow] ** 2))) if (~slow).any() else 0.0
+                shape.append(
+                    f"{100 * share_slow:.0f} % of it lies where the axis stands or moves under "
+                    f"{frac * vtop * 1e3:.2g} mm/s ({100 * frac:g} % of the top speed, "
+                    f"{100 * slow.mean():.1f} % of the time): "
+                    f"{float(np.sqrt(np.mean(rr[slow] ** 2))):.3g} N rms there against "
+                    f"{fast:.3g} N faster. The friction at standstill and low speed (static "
+                    "friction, breakaway, the Stribeck fall, presliding) is unlike the model's: "
+                    "a slow current ramp at standstill in both directions, and constant-speed "
+                    "passes at a few mm/s, measure it")
+                break
     if d.get("positive") and d.get("negative"):
         ratio = d["positive"] / d["negative"]
         if ratio > 1.5 or ratio < 1 / 1.5:
