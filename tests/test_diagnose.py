@@ -886,3 +886,25 @@ def test_a_wrong_timing_in_the_model_is_replaced(given):
     right = diagnose(rec, _with_effects(believed, [{"effect": "delay", "seconds": 0.001}]),
                      closed_loop=False)
     assert right.removed == [] and right.findings == []
+
+
+def test_a_one_of_a_kind_effect_refined_by_little_is_kept():
+    # a refinement is no contradiction: a model's delay within 5 % of what the record
+    # prefers stays as given (a lightly damped resonance at 23.7 Hz preferred at 23.6 Hz
+    # on a hold-out record had been "replaced"), one 25 % off is replaced
+    from lugre.diagnosis.core import _differs
+
+    assert not _differs({"effect": "resonance", "frequency": 23.7, "damping_ratio": 0.036,
+                         "load_fraction": 0.48},
+                        {"frequency": 23.6, "damping_ratio": 0.036, "load_fraction": 0.48})
+    assert _differs({"effect": "current_lag", "bandwidth": 400.0},
+                    {"seconds": 0.00096, "bandwidth": 166.0})
+    assert not _differs({"effect": "current_lag", "bandwidth": 166.0},
+                        {"seconds": 0.00096, "bandwidth": 170.0})
+    rec, believed, _ = concealed({"effect": "delay", "seconds": 0.001}, duration=10.0)
+    near = diagnose(rec, _with_effects(believed, [{"effect": "delay", "seconds": 0.00098}]),
+                    closed_loop=False)
+    assert near.removed == []
+    far = diagnose(rec, _with_effects(believed, [{"effect": "delay", "seconds": 0.00075}]),
+                   closed_loop=False)
+    assert [r["effect"] for r in far.removed] == ["delay"]
