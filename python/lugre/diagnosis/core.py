@@ -31,8 +31,8 @@ from .search import (
 )
 from .simex import noise_made, surrogates
 
-__all__ = ["EXCESS_FLOOR", "MIN_SHARE", "PARTIAL_REST", "as_recording", "diagnose", "evaluate",
-           "question_effects"]
+__all__ = ["EXCESS_FLOOR", "MIN_SHARE", "ONE_OF_A_KIND", "PARTIAL_REST", "as_recording",
+           "diagnose", "evaluate"]
 
 #: Least rms force of a finding, as a share of the rms motor force: effects below it are
 #: statistically visible on clean records (a 0.1 % mass error, the half period of a
@@ -332,59 +332,14 @@ def _diagnose(
     if _given is not None:
         model_given, removed = _given[0], list(_given[1])
         r0_given = R.residual(model_given, sig)
-    contradicted: list[dict[str, Any]] = []
     if _question and model.effects:
-        model, contradicted = question_effects(model, sig, r0, blocks=blocks, alpha=alpha,
-                                               min_gain=min_gain, step=step,
-                                               tolerance=tolerance)
-        # one of a kind (a timing term, a resonance, a Stribeck shape) is not searched
-        # beside the model's own: the record is searched for that kind again without
-        # it, and the one it finds replaces the model's when it predicts the held-out
-        # stretches better (a delay given from another session; a resonance moved)
-        for k, e in reversed(list(enumerate(model.effects))):
-            kind = "delay" if e["effect"] in ("delay", "current_lag") else str(e["effect"])
-            if kind not in ("delay", "resonance", "stribeck_shape"):
-                continue
-            m_k = _without(model, {k})
-            try:
-                sub = _diagnose(rec, m_k, cutoff_hz=cutoff_hz, blocks=blocks, alpha=alpha,
-                                min_gain=min_gain, closed_loop=False, candidates=[kind],
-                                screw_lead=screw_lead, tolerance=tolerance,
-                                backend=backend, _question=False)
-            except ValueError:
-                continue
-            again = [f for f in sub.findings
-                     if ("delay" if f.effect == "current_lag" else f.effect) == kind]
-            # a refinement is no contradiction: the one found must differ by more than
-            # 5 % in some parameter (a lightly damped 23.7 Hz resonance preferred at
-            # 23.6 Hz on a hold-out record stays as given)
-            if not again or not _differs(e, again[0].parameters):
-                continue
-            # the model with the one found in place of its own, all else as given: the
-            # comparison is of the two alone (the search's refit of the friction levels
-            # is no part of it)
-            found = [x for x in sub.augmented.effects[len(m_k.effects):]
-                     if ("delay" if x["effect"] == "current_lag" else x["effect"]) == kind]
-            d_sub = m_k.to_dict()
-            d_sub["effects"] = list(d_sub["effects"]) + found[:1]
-            try:
-                r_sub = R.residual(Model.from_dict(d_sub), sig)
-            except ValueError:
-                continue
-            res = _removals(model, sig, R.residual(model, sig), [], blocks=blocks,
-                            step=step, tolerance=tolerance, others=[r_sub])
-            pt = res[0][0] if res and res[0] is not None else None
-            if pt is None or not accept(pt, alpha=alpha, min_gain=min_gain)[0]:
-                continue
-            f = again[0]
-            contradicted.append(_removed_entry(
-                e, pt, accept(pt, alpha=alpha, min_gain=min_gain)[1],
-                instead=f"{f.effect.replace('_', ' ')} ({V.effect_words(f.effect, f.parameters)})",
-                moved=_moved(e, f.parameters) if f.effect == e["effect"] else ""))
-            model = m_k
-    if contradicted:
-        removed += contradicted
-        r0 = R.residual(model, sig)
+        settings: dict[str, Any] = {"blocks": blocks, "alpha": alpha, "min_gain": min_gain,
+                                    "step": step, "tolerance": tolerance}
+        model, contradicted, r0 = question_effects(model, sig, r0, **settings)
+        model, replaced, r0 = replace_one_of_a_kind(
+            rec, model, sig, r0, cutoff_hz=cutoff_hz, screw_lead=screw_lead,
+            backend=backend, **settings)
+        removed += contradicted + replaced
     fr0 = R.base_friction(model, sig)
     ctx = E.Context.build(sig, model, fr0)
     lead = screw_lead if screw_lead is not None else model.axis.get("screw_lead")
@@ -397,12 +352,8 @@ def _diagnose(
     J, names, _, tol = B.base_jacobian(model, sig, names=wanted)
     tol = tol * float(tolerance)
     held = [k for k, n in enumerate(names) if n not in B.PRESLIDING]
-    noise = R.noise_floor(r0, sig)
-    s2 = noise["rms"] ** 2 * n_used / noise["n_eff"]
     ctx.extra["rows_step"] = step
-    ev_held = Scorer(r0, J[:, held], tol[held], sig.mask, s2, blocks, step=step).evaluate([])
-    noise = R.noise_floor(ev_held.resid, sig)  # floor of the base-refit residual
-    s2 = noise["rms"] ** 2 * n_used / noise["n_eff"]
+    noise, s2 = _variance_unit(r0, J[:, held], tol[held], sig, blocks, step)
     sc_held = Scorer(r0, J[:, held], tol[held], sig.mask, s2, blocks, step=step)
     sc_free = Scorer(r0, J, tol, sig.mask, s2, blocks, step=step)
     ev_held = sc_held.evaluate([])
@@ -926,65 +877,76 @@ def _without(model: Model, drop: set[int]) -> Model:
     return Model.from_dict(d)
 
 
-def _removals(model: Model, sig: R.Signals, r: np.ndarray, sets: list[set[int]], *,
-              blocks: int, step: int, tolerance: float,
-              others: list[np.ndarray] | None = None
-              ) -> list[tuple[dict[str, Any], dict[str, Any], Model | None] | None]:
-    """Held-out evidence of taking each set of ``model``'s effects out: per set, the
-    gain of removing it and the gain of keeping it (:func:`compare`, the friction levels
-    refitted in both), and the model without it; ``None`` where no valid model is left.
-    ``r`` is ``model``'s residual; ``others``: residuals of other models, judged the
-    same way (after the sets, without a model)."""
+def _variance_unit(r: np.ndarray, J: np.ndarray, tol: np.ndarray, sig: R.Signals,
+                   blocks: int, step: int) -> tuple[dict[str, float], float]:
+    """The noise floor of the base refit's residual and the scores' variance unit
+    ``s2`` (its rms squared over the effective number of samples, in every sample)."""
     n_used = int(sig.mask.sum())
-    J, _, _, tol = B.base_jacobian(model, sig, names=B.LEVELS)
-    tol = tol * float(tolerance)
-    # the variance unit of the base refit's residual, as the search reads it
     noise = R.noise_floor(r, sig)
     s2 = noise["rms"] ** 2 * n_used / noise["n_eff"]
     ev = Scorer(r, J, tol, sig.mask, s2, blocks, step=step).evaluate([])
     noise = R.noise_floor(ev.resid, sig)
-    s2 = noise["rms"] ** 2 * n_used / noise["n_eff"]
+    return noise, noise["rms"] ** 2 * n_used / noise["n_eff"]
+
+
+Removal = tuple[dict[str, Any], dict[str, Any], Model | None, np.ndarray]
+
+
+def _removals(model: Model, sig: R.Signals, r: np.ndarray, sets: list[set[int]], *,
+              blocks: int, step: int, tolerance: float,
+              others: list[np.ndarray] | None = None) -> list[Removal | None]:
+    """Held-out evidence of taking each set of ``model``'s effects out: per set, the
+    gain of removing it and the gain of keeping it (:func:`compare`, the friction levels
+    refitted in both), the model without it and its residual; ``None`` where no valid
+    model is left. ``r`` is ``model``'s residual; ``others``: residuals of other models,
+    judged the same way (after the sets, without a model)."""
+    J, _, _, tol = B.base_jacobian(model, sig, names=B.LEVELS)
+    tol = tol * float(tolerance)
+    _, s2 = _variance_unit(r, J, tol, sig, blocks, step)
     sc = Scorer(r, J, tol, sig.mask, s2, blocks, step=step)
     ev = sc.evaluate([])
-    out: list[tuple[dict[str, Any], dict[str, Any], Model] | None] = []
+
+    def judged(m_o: Model | None, r_o: np.ndarray) -> Removal | None:
+        if not np.all(np.isfinite(r_o[sig.mask])):
+            return None
+        ev_o = sc.like(r=r_o).evaluate([])
+        return compare(ev, ev_o, s2), compare(ev_o, ev, s2), m_o, r_o
+
+    out: list[Removal | None] = []
     for drop in sets:
         try:
             m_s = _without(model, drop)
-            r_s = R.residual(m_s, sig)
+            out.append(judged(m_s, R.residual(m_s, sig)))
         except ValueError:  # no valid model without them (they hold the others up)
             out.append(None)
-            continue
-        if not np.all(np.isfinite(r_s[sig.mask])):
-            out.append(None)
-            continue
-        ev_s = sc.like(r=r_s).evaluate([])
-        out.append((compare(ev, ev_s, s2), compare(ev_s, ev, s2), m_s))
-    for r_o in others or []:
-        if not np.all(np.isfinite(r_o[sig.mask])):
-            out.append(None)
-            continue
-        ev_o = sc.like(r=r_o).evaluate([])
-        out.append((compare(ev, ev_o, s2), compare(ev_o, ev, s2), None))
-    return out
+    return out + [judged(None, r_o) for r_o in others or []]
 
 
-def _differs(old: dict[str, Any], new: dict[str, Any], rel: float = 0.05) -> bool:
-    """Whether an effect found differs from the model's of its kind by more than ``rel``
-    in a parameter they share, or (a timing term of the other form) in its effective
-    delay."""
+#: A parameter of a one-of-a-kind effect found that differs from the model's by more
+#: than this share has moved (less is a refinement)
+MOVED_SHARE = 0.05
+
+
+def _far(a: float, b: float) -> bool:
+    return abs(a - b) > MOVED_SHARE * max(abs(a), abs(b))
+
+
+def _differs(old: dict[str, Any], new: dict[str, Any]) -> bool:
+    """Whether an effect found differs from the model's of its kind by more than
+    :data:`MOVED_SHARE` in a parameter they share, or (a timing term of the other form)
+    in its effective delay."""
     shared = [k for k, v in new.items()
               if isinstance(v, (int, float)) and isinstance(old.get(k), (int, float))]
     if old.get("effect") == "current_lag" and "seconds" not in old:
         shared = []  # a lag given by its bandwidth: compared by its mean delay below
     if shared:
-        return any(abs(new[k] - old[k]) > rel * max(abs(new[k]), abs(old[k]))
-                   for k in shared)
+        return any(_far(new[k], old[k]) for k in shared)
     sec_old = old.get("seconds")
     if sec_old is None and old.get("bandwidth"):
         sec_old = 1.0 / (2.0 * math.pi * float(old["bandwidth"]))
     sec_new = new.get("seconds")
     if isinstance(sec_old, (int, float)) and isinstance(sec_new, (int, float)):
-        return abs(sec_new - sec_old) > rel * max(abs(sec_new), abs(sec_old))
+        return _far(sec_new, sec_old)
     return True
 
 
@@ -996,7 +958,7 @@ def _moved(old: dict[str, Any], new: dict[str, Any]) -> str:
         w = old.get(k)
         if not isinstance(v, (int, float)) or not isinstance(w, (int, float)):
             continue
-        if abs(v - w) > 0.05 * max(abs(v), abs(w)):
+        if _far(v, w):
             moved.append(f"{k} {w:.3g} -> {v:.3g}")
         else:
             same.append(k)
@@ -1039,7 +1001,7 @@ def _removed_entry(e: dict[str, Any], pt: dict[str, Any], why: str, *,
 
 def question_effects(model: Model, sig: R.Signals, r0: np.ndarray, *, blocks: int,
                      alpha: float, min_gain: float, step: int, tolerance: float
-                     ) -> tuple[Model, list[dict[str, Any]]]:
+                     ) -> tuple[Model, list[dict[str, Any]], np.ndarray]:
     """The model's own effects that the record contradicts, removed one at a time.
 
     Each effect the model holds is taken out in turn and the residual of the model
@@ -1051,10 +1013,10 @@ def question_effects(model: Model, sig: R.Signals, r0: np.ndarray, *, blocks: in
 
     Returns
     -------
-    (Model, list of dict)
-        The model without the contradicted effects, and per removed effect ``effect``,
+    (Model, list of dict, numpy.ndarray)
+        The model without the contradicted effects; per removed effect ``effect``,
         ``parameters``, ``evidence`` (in words) and the block test (``gain``, ``p``,
-        ``positive``, ``blocks``).
+        ``positive``, ``blocks``); the residual of the model returned.
     """
     removed: list[dict[str, Any]] = []
     cur, r_cur = model, r0
@@ -1067,13 +1029,69 @@ def question_effects(model: Model, sig: R.Signals, r0: np.ndarray, *, blocks: in
                 continue
             ok, why = accept(res[0], alpha=alpha, min_gain=min_gain)
             if ok and (best is None or res[0]["gain"] > best[1]["gain"]):
-                best = (k, res[0], res[2], why)
+                best = (k, res[0], res[2], res[3], why)
         if best is None:
             break
-        k, pt, m_k, why = best
+        k, pt, m_k, r_k, why = best
         removed.append(_removed_entry(cur.effects[k], pt, why))
-        cur, r_cur = m_k, R.residual(m_k, sig)
-    return cur, removed
+        cur, r_cur = m_k, r_k
+    return cur, removed, r_cur
+
+
+def replace_one_of_a_kind(rec: Recording, model: Model, sig: R.Signals, r: np.ndarray, *,
+                          cutoff_hz: float | None, screw_lead: float | None, backend: str,
+                          blocks: int, alpha: float, min_gain: float, step: int,
+                          tolerance: float
+                          ) -> tuple[Model, list[dict[str, Any]], np.ndarray]:
+    """One of a kind (a timing term, a resonance, a Stribeck shape) is not searched
+    beside the model's own: the record is diagnosed for that kind again without it, and
+    the one found replaces the model's when, put in its place with all else as given,
+    it predicts the held-out blocks better (:func:`accept`) and differs from it by more
+    than 5 % in a parameter (a delay given from another session; a resonance moved).
+    ``r`` is ``model``'s residual; returns the model, the replaced effects' entries (as
+    :func:`question_effects`) and the model's residual."""
+    replaced: list[dict[str, Any]] = []
+    for k, e in reversed(list(enumerate(model.effects))):
+        kind = _kind(e["effect"])
+        if kind not in ONE_OF_A_KIND:
+            continue
+        m_k = _without(model, {k})
+        try:
+            sub = _diagnose(rec, m_k, cutoff_hz=cutoff_hz, blocks=blocks, alpha=alpha,
+                            min_gain=min_gain, closed_loop=False, candidates=[kind],
+                            screw_lead=screw_lead, tolerance=tolerance, backend=backend,
+                            _question=False)
+        except ValueError:
+            continue
+        again = [f for f in sub.findings if _kind(f.effect) == kind]
+        # a refinement is no contradiction (a lightly damped 23.7 Hz resonance
+        # preferred at 23.6 Hz on a hold-out record stays as given)
+        if not again or not _differs(e, again[0].parameters):
+            continue
+        # the one found in place of the model's, all else as given: the two alone are
+        # compared (the search's refit of the friction levels is no part of it)
+        d_sub = m_k.to_dict()
+        d_sub["effects"] = list(d_sub["effects"]) + [
+            x for x in sub.augmented.effects[len(m_k.effects):]
+            if _kind(x["effect"]) == kind][:1]
+        try:
+            r_sub = R.residual(Model.from_dict(d_sub), sig)
+        except ValueError:
+            continue
+        (res,) = _removals(model, sig, r, [], blocks=blocks, step=step,
+                           tolerance=tolerance, others=[r_sub])
+        if res is None:
+            continue
+        ok, why = accept(res[0], alpha=alpha, min_gain=min_gain)
+        if not ok:
+            continue
+        f = again[0]
+        replaced.append(_removed_entry(
+            e, res[0], why,
+            instead=f"{f.effect.replace('_', ' ')} ({V.effect_words(f.effect, f.parameters)})",
+            moved=_moved(e, f.parameters) if f.effect == e["effect"] else ""))
+        model, r = m_k, R.residual(m_k, sig)
+    return model, replaced, r
 
 
 def contradicted_beside(aug: Model, n_given: int, sig: R.Signals, r: np.ndarray, *,
@@ -1084,7 +1102,6 @@ def contradicted_beside(aug: Model, n_given: int, sig: R.Signals, r: np.ndarray,
     stretches, or the search found the same kind of effect beside it and the two
     together do not earn their place (a drift of 5 % given, -4.8 % found). ``r`` is
     ``aug``'s residual. Returns ``(index, removed entry)`` pairs."""
-    kind = {"current_lag": "delay"}
     effs = aug.effects
     sets: list[set[int]] = []
     pairs: list[bool] = []
@@ -1092,8 +1109,7 @@ def contradicted_beside(aug: Model, n_given: int, sig: R.Signals, r: np.ndarray,
         sets.append({k})
         pairs.append(False)
         same = {j for j in range(n_given, len(effs))
-                if kind.get(effs[j]["effect"], effs[j]["effect"])
-                == kind.get(effs[k]["effect"], effs[k]["effect"])}
+                if _kind(effs[j]["effect"]) == _kind(effs[k]["effect"])}
         if same:
             sets.append({k} | same)
             pairs.append(True)
@@ -1161,14 +1177,19 @@ def _origin_notes(removed: list[dict[str, Any]], findings: list[Finding]) -> lis
     return out
 
 
+#: Kinds a model holds once at most (the timing candidate is ``delay``, for both forms).
+ONE_OF_A_KIND = ("delay", "resonance", "stribeck_shape")
+
+
+def _kind(effect: str) -> str:
+    """An effect's kind: its name, but ``delay`` for both timing forms."""
+    return "delay" if effect in ("delay", "current_lag") else str(effect)
+
+
 def _held_kinds(model: Model) -> set[str]:
     """Candidates the model leaves no room for: effects it may hold once and already
-    holds (the timing candidate is ``delay``, for both of its forms)."""
-    have = {e["effect"] for e in model.effects}
-    kinds = {k for k in ("resonance", "stribeck_shape") if k in have}
-    if have & {"delay", "current_lag"}:
-        kinds.add("delay")
-    return kinds
+    holds."""
+    return {_kind(e["effect"]) for e in model.effects} & set(ONE_OF_A_KIND)
 
 
 def _rms(y: np.ndarray, mask: np.ndarray) -> float:
