@@ -70,6 +70,11 @@ class InverseRecord:
     def base_sensitivities(
         self, model: _ModelArg, names: list[str]
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], list[bool]]: ...
+    def fit_base(
+        self, starts: list[_ModelArg], mask: list[bool], names: list[str],
+        max_iter: int = 60, keep: int = 3, scouts: int = 12,
+        weighting: str = "huber",
+    ) -> dict[str, Any]: ...
 
 _F64: TypeAlias = npt.NDArray[np.float64]
 

@@ -19,9 +19,11 @@
 //! step by the NumPy twin `lugre.reference.InverseRecord`.
 
 mod filter;
+mod fit;
 mod spectrum;
 
 pub use filter::{Lowpass, LANES};
+pub use fit::{fit_base, BaseFit, BaseFitOptions, FitParam};
 pub use spectrum::{position_sums, PositionSums, MAX_FREQUENCIES, RESEED};
 
 use crate::error::{check_finite, check_len, Error, Result};

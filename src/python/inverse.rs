@@ -3,11 +3,15 @@
 
 use super::{slice, to_py};
 use crate::error::Error;
-use crate::inverse::{position_sums as sums, BaseParam, Lowpass, Record};
+use crate::estimate::Weighting;
+use crate::inverse::{
+    fit_base as base_fit, position_sums as sums, BaseFitOptions, BaseParam, Lowpass, Record,
+};
 use crate::servo::Model;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use std::sync::Arc;
 
 /// A validated model, parsed once and passed to every call of the core.
@@ -273,6 +277,70 @@ impl PyInverseRecord {
             .detach(|| self.rec.residuals(&ms))
             .map_err(|e| to_py(py, e))?;
         Ok(columns_major(n, cols).into_pyarray(py))
+    }
+
+    /// The base parameters `names` fitted from `starts` by IGG-weighted
+    /// Levenberg-Marquardt on the residual at the `mask`ed samples (see
+    /// `lugre::inverse::fit_base`). A dict: `values` (every base parameter of the best
+    /// model by path), `cost`, `scale`, `criterion`, `weights`, `information` (`q x q`),
+    /// `start`, `iterations`, `evaluations`.
+    #[pyo3(signature = (starts, mask, names, max_iter=60, keep=3, scouts=12, weighting="huber"))]
+    #[allow(clippy::too_many_arguments)]
+    fn fit_base<'py>(
+        &self,
+        py: Python<'py>,
+        starts: Vec<Bound<'py, PyAny>>,
+        mask: Vec<bool>,
+        names: Vec<String>,
+        max_iter: usize,
+        keep: usize,
+        scouts: usize,
+        weighting: &str,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let ms = starts
+            .iter()
+            .map(|m| model_of(py, m).map(|m| (*m).clone()))
+            .collect::<PyResult<Vec<_>>>()?;
+        let opts = BaseFitOptions {
+            max_iter,
+            keep,
+            scouts,
+            weighting: Weighting::from_name(weighting).map_err(|e| to_py(py, e))?,
+            ..BaseFitOptions::default()
+        };
+        let fit = py
+            .detach(|| base_fit(&self.rec, &ms, &mask, &names, &opts))
+            .map_err(|e| to_py(py, e))?;
+        let m = &fit.model;
+        let f = &m.friction;
+        let values = PyDict::new(py);
+        values.set_item("mass", m.axis.mass)?;
+        for (side, s) in [("positive", &f.positive), ("negative", &f.negative)] {
+            for (k, v) in [
+                ("fc", s.fc),
+                ("fs", s.fs),
+                ("sigma2", s.sigma2),
+                ("vs", s.vs),
+            ] {
+                values.set_item(format!("{side}.{k}"), v)?;
+            }
+        }
+        values.set_item("sigma0", f.sigma0)?;
+        values.set_item("sigma1", f.sigma1)?;
+        let q = names.len();
+        let info =
+            Array2::from_shape_vec((q, q), fit.information.clone()).expect("q x q information");
+        let out = PyDict::new(py);
+        out.set_item("values", values)?;
+        out.set_item("cost", fit.cost)?;
+        out.set_item("scale", fit.scale)?;
+        out.set_item("criterion", fit.criterion)?;
+        out.set_item("weights", fit.weights.into_pyarray(py))?;
+        out.set_item("information", info.into_pyarray(py))?;
+        out.set_item("start", fit.start)?;
+        out.set_item("iterations", fit.iterations)?;
+        out.set_item("evaluations", fit.evaluations)?;
+        Ok(out)
     }
 
     /// `(force, J, nonzero)`: the unfiltered LuGre force, its filtered derivatives with

@@ -29,6 +29,7 @@ def fit_inverse_dynamics(
     cutoff_hz: float | None = None,
     controller: dict[str, Any] | None = None,
     backend: str = "core",
+    sliding: float | None = None,
 ) -> Model:
     """Fit a LuGre axis model by robust least squares on the inverse dynamics.
 
@@ -58,6 +59,11 @@ def fit_inverse_dynamics(
         Controller section to put in the model.
     backend : {"core", "reference"}, default "core"
         The compiled inverse-dynamics kernel and robust fit, or their NumPy twins.
+    sliding : float, optional
+        Use only the samples moving faster than this share of the largest speed (and
+        than ten encoder counts per sample): where the axis slides, the static curve is
+        the friction; where it sticks, the friction is whatever the drive pushes with.
+        Default: every sample.
 
     Returns
     -------
@@ -72,6 +78,11 @@ def fit_inverse_dynamics(
     v = sig.v
     m = sig.mask
     vmax = float(np.max(np.abs(sig.vf[m])))
+    if sliding is not None:
+        q = float(sig.info.get("quantum", 0.0))
+        m = m & (np.abs(sig.vf) > max(sliding * vmax, 10 * q / sig.dt))
+        if min(np.sum(m & (sig.vf > 0)), np.sum(m & (sig.vf < 0))) < 20:
+            m = sig.mask
     pos, neg = (v > 0).astype(float), (v < 0).astype(float)
     y = sig.fm_f.copy()
     if mass is not None:
@@ -81,7 +92,10 @@ def fit_inverse_dynamics(
         sig.filt(pos), sig.filt(pos * v), sig.filt(-neg), sig.filt(neg * v)]
     X = np.column_stack(base)[m]
     # one candidate per vs of the grid: the Stribeck hump of each direction
-    grid = vmax * np.logspace(-2.5, -0.5, 15) if vmax > 0 else np.zeros(0)
+    # (sliding samples only: up to the largest speed, for a record that stays within
+    # the Stribeck range)
+    top = -0.5 if sliding is None else 0.0
+    grid = vmax * np.logspace(-2.5, top, 15) if vmax > 0 else np.zeros(0)
     extras = []
     for vs_k in grid:
         e = np.exp(-(v / vs_k) ** 2)

@@ -1,0 +1,279 @@
+"""The base model fitted where the record puts it: mass and per-direction LuGre
+friction by robust Levenberg-Marquardt on the inverse-dynamics residual (the kernel's
+``fit_base``), from starts that cover the Stribeck hump and the bristle stiffness, and
+each parameter's profile (the fit with it moved and the rest refitted) for its interval
+and whether the record determines it."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..model import Model
+from . import residual as R
+from .base import apply_base, get_base
+
+__all__ = ["BaseFitResult", "base_names", "fit_base", "identify", "profile_all", "starts"]
+
+#: A profile that rises by less than this (chi-square, one parameter, 95 %) over a
+#: factor of ten either way leaves the parameter not determined on that side.
+CHI2_95 = 3.841
+
+#: Factor a profile goes out to before it calls a side unbounded.
+PROFILE_SPAN = 10.0
+
+#: The linear start fitted where the axis slides faster than this share of its
+#: largest speed (the static curve describes sliding, not sticking).
+SLIDING = 0.05
+
+#: Starts: hump ratios fs/fc, Stribeck speeds (shares of the largest speed) and
+#: presliding displacements fs/sigma0 (shares of the stroke, at least a few counts).
+RATIOS = (1.0, 1.5, 2.2, 3.2)
+#: ... and shares of the linear fit's Coulomb level (the rest of the mean sliding
+#: friction given to the viscous term): the linear fit trades one for the other.
+FC_SHARES = (1.0, 0.6, 0.35)
+
+SIDES = ("positive", "negative")
+
+#: Starts followed a few iterations before the best few are followed to the end.
+SCOUTS = 24
+VS_SHARES = (0.003, 0.01, 0.03, 0.1, 0.3)
+
+
+@dataclass(frozen=True)
+class BaseFitResult:
+    """A base fit: the model, its parameters' intervals and what the record leaves open.
+
+    ``profiles[name]`` holds ``value``, ``ci95`` ([lo, hi], None for an unbounded side),
+    ``determined`` and ``how`` (``"wald"`` or ``"profile"``) for every fitted parameter
+    (``positive.hump`` is ``fs - fc``).
+    """
+
+    model: Model
+    names: tuple[str, ...]
+    scale: float
+    rms: float
+    noise: float
+    n_eff: float
+    evaluations: int
+    profiles: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+
+def base_names(free_mass: bool) -> list[str]:
+    """The fitted parameters: mass (when free), the four of each direction, sigma0 and
+    sigma1."""
+    out = ["mass"] if free_mass else []
+    for d in ("positive", "negative"):
+        out += [f"{d}.fc", f"{d}.hump", f"{d}.sigma2", f"{d}.vs"]
+    return out + ["sigma0", "sigma1"]
+
+
+def starts(model: Model, sig: R.Signals) -> list[Model]:
+    """Start models around ``model`` (its levels and mass kept): every hump ratio,
+    Stribeck speed and presliding displacement of the grids, the model itself first."""
+    vmax = float(np.max(np.abs(sig.v[sig.mask]))) or 1e-6
+    xs = sig.x[sig.mask]
+    stroke = float(np.ptp(xs)) or 1e-6
+    q = max(float(sig.info.get("quantum", 0.0)), stroke * 1e-7)
+    pre = np.geomspace(max(3 * q, stroke * 1e-5), max(stroke * 0.02, 6 * q), 4)
+    speeds = np.abs(sig.v[sig.mask])
+    sliding = speeds[speeds > SLIDING * vmax]
+    vmean = float(np.mean(sliding)) if sliding.size else vmax
+    out = [model]
+    fr = model.friction
+    levels = [{d: (float(fr[d]["fc"]) * k, float(fr[d]["sigma2"])
+                   + (1 - k) * float(fr[d]["fc"]) / vmean) for d in SIDES} for k in FC_SHARES]
+    # a direction whose linear fit went astray (no hump found, the slope taken up by
+    # the Coulomb level) started from the other's levels
+    levels += [{d: (float(fr[o]["fc"]), float(fr[o]["sigma2"])) for d in SIDES} for o in SIDES]
+    for ratio, share, x0, lv in itertools.product(RATIOS, VS_SHARES, pre, levels):
+        vals: dict[str, float] = {}
+        for d in SIDES:
+            vals[f"{d}.fc"], vals[f"{d}.sigma2"] = lv[d]
+            vals[f"{d}.fs"] = lv[d][0] * ratio
+            vals[f"{d}.vs"] = share * vmax
+        vals["sigma0"] = max(vals["positive.fs"], vals["negative.fs"]) / x0
+        vals["sigma1"] = 0.05 * math.sqrt(vals["sigma0"] * model.mass)
+        out.append(apply_base(model, vals))
+    return out
+
+
+def _model_of(model: Model, values: dict[str, float]) -> Model:
+    return apply_base(model, {k: v for k, v in values.items()})
+
+
+def _run(sig: R.Signals, start: list[Model], names: list[str], keep: int = 3,
+         max_iter: int = 60) -> tuple[Model, dict[str, Any]]:
+    out = sig.kernel.fit_base(start, [bool(b) for b in sig.mask], names,
+                              max_iter=max_iter, keep=keep, scouts=max(keep, SCOUTS))
+    return _model_of(start[out["start"]], out["values"]), out
+
+
+def _value(model: Model, name: str) -> float:
+    if name.endswith(".hump"):
+        d = name.split(".")[0]
+        return get_base(model, f"{d}.fs") - get_base(model, f"{d}.fc")
+    return get_base(model, name)
+
+
+def _with(model: Model, name: str, value: float) -> Model:
+    if name.endswith(".hump"):
+        d = name.split(".")[0]
+        return apply_base(model, {f"{d}.fs": get_base(model, f"{d}.fc") + value})
+    if name.endswith(".fc"):
+        d = name.split(".")[0]
+        hump = _value(model, f"{d}.hump")
+        return apply_base(model, {name: value, f"{d}.fs": value + hump})
+    return apply_base(model, {name: value})
+
+
+def fit_base(sig: R.Signals, model: Model, *, free_mass: bool, extra: list[Model] | None = None,
+             profiles: bool = True) -> BaseFitResult:
+    """Fit the base of ``model`` to a prepared record from the start grid (and
+    ``extra`` starts), then profile each parameter.
+
+    Parameters
+    ----------
+    sig : Signals
+        The prepared record (its kernel: the core's or the twin's).
+    model : Model
+        The levels and mass to start from (its effects are held).
+    free_mass : bool
+        Fit the mass too.
+    extra : list of Model, optional
+        Further starts (a model given by the user).
+    profiles : bool, default True
+        Work out each parameter's interval and whether the record determines it.
+
+    Returns
+    -------
+    BaseFitResult
+    """
+    names = base_names(free_mass)
+    best, out = _run(sig, starts(model, sig) + list(extra or []), names)
+    r = np.asarray(sig.kernel.residual(best))
+    nf = R.noise_floor(r, sig)
+    used = r[sig.mask]
+    res = BaseFitResult(model=best, names=tuple(names), scale=float(out["scale"]),
+                        rms=float(np.sqrt(np.mean(used * used))), noise=float(nf["rms"]),
+                        n_eff=float(nf["n_eff"]), evaluations=int(out["evaluations"]))
+    if profiles:
+        res.profiles.update(profile_all(sig, res, out["information"]))
+    return res
+
+
+def _chi2(sig: R.Signals, model: Model, q0: float, cut: float, s2: float, ratio: float) -> float:
+    r = np.asarray(sig.kernel.residual(model))[sig.mask]
+    q = float(np.sum(np.minimum(r * r, cut)))
+    return (q - q0) / s2 * ratio
+
+
+def profile_all(sig: R.Signals, res: BaseFitResult, info: np.ndarray) -> dict[str, dict[str, Any]]:
+    """Intervals of every fitted parameter: from the information where it bounds the
+    parameter to within 10 % (the profile is then quadratic), else from the profile,
+    refitting the others at each point."""
+    names = list(res.names)
+    best = res.model
+    n_used = int(sig.mask.sum())
+    ratio = min(1.0, res.n_eff / max(n_used, 1))
+    s2 = res.scale ** 2
+    cut = (2.5 * res.scale) ** 2
+    r0 = np.asarray(sig.kernel.residual(best))[sig.mask]
+    q0 = float(np.sum(np.minimum(r0 * r0, cut)))
+    info = np.asarray(info, dtype=float)
+    try:
+        cov = np.linalg.pinv(info) * s2 / ratio
+    except np.linalg.LinAlgError:  # pragma: no cover - pinv converges
+        cov = np.full_like(info, np.inf)
+    out: dict[str, dict[str, Any]] = {}
+    for k, name in enumerate(names):
+        val = _value(best, name)
+        se = math.sqrt(max(cov[k, k], 0.0))
+        if name.endswith(".vs") and _value(best, name.replace(".vs", ".hump")) < 1e-3 * max(
+                get_base(best, name.replace(".vs", ".fc")), 1e-12):
+            out[name] = {"value": val, "ci95": None, "determined": False, "how": "no hump",
+                         "se": math.nan}
+            continue
+        if val > 0 and 1.96 * se <= 0.1 * val:
+            out[name] = {"value": val, "ci95": [val - 1.96 * se, val + 1.96 * se],
+                         "determined": True, "how": "wald", "se": se}
+            continue
+        others = [n for n in names if n != name]
+        ends: list[float | None] = []
+        for sgn in (-1.0, 1.0):
+            ends.append(_profile_side(sig, best, name, val, sgn, others,
+                                      lambda m: _chi2(sig, m, q0, cut, s2, ratio)))
+        lo, hi = ends
+        det = lo is not None and hi is not None
+        out[name] = {"value": val, "ci95": [lo, hi], "determined": det, "how": "profile",
+                     "se": se}
+    return out
+
+
+def _profile_side(sig: R.Signals, best: Model, name: str, val: float, sgn: float,
+                  others: list[str], chi2: Any) -> float | None:
+    """Where the profile on one side crosses the 95 % level (None: within the noise
+    out to a factor of ten, or to zero for a hump)."""
+    hump = name.endswith(".hump")
+    fc = get_base(best, name.replace(".hump", ".fc")) if hump else 0.0
+    if hump:  # additive steps: the hump may be zero
+        steps = [0.05 * fc, 0.2 * fc, 1.0 * fc]
+        pts = [val + sgn * s for s in steps]
+    else:
+        pts = [val * PROFILE_SPAN ** (sgn * f) for f in (0.05, 0.3, 1.0)]
+    prev_x, prev_c = val, 0.0
+    for x in pts:
+        if x <= 0:
+            return 0.0 if hump or name.endswith(("sigma1", "sigma2")) else None
+        m = _with(best, name, x)
+        fitted, _ = _run(sig, [m], others, keep=1, max_iter=25)
+        c = max(chi2(fitted), 0.0)
+        if c >= CHI2_95:
+            # linear in the chi-square's square root between the last two points
+            a, b = math.sqrt(prev_c), math.sqrt(c)
+            f = (math.sqrt(CHI2_95) - a) / (b - a) if b > a else 1.0
+            return prev_x + f * (x - prev_x)
+        prev_x, prev_c = x, c
+    return None
+
+
+def identify(recording: Any, *, mass: float | None = None, force_constant: float = 1.0,
+             cutoff_hz: float | None = None, controller: dict[str, Any] | None = None,
+             backend: str = "core", profiles: bool = True) -> BaseFitResult:
+    """Identify an axis's base model from a recording: the inverse-dynamics levels
+    (robust linear least squares) as the start of :func:`fit_base`.
+
+    Parameters
+    ----------
+    recording : Recording or path
+        With motion in both directions.
+    mass : float, optional
+        Known mass [kg]; fitted otherwise.
+    force_constant : float, default 1.0
+        K_F [N/A].
+    cutoff_hz : float, optional
+        Low-pass cut-off (default ``fs/25``).
+    controller : dict, optional
+        Controller section to put in the model.
+    backend : {"core", "reference"}
+        The kernels of the compiled core or of the NumPy twin.
+    profiles : bool, default True
+        Intervals and determinacy of every parameter.
+
+    Returns
+    -------
+    BaseFitResult
+    """
+    from .core import as_recording
+    from .inverse import fit_inverse_dynamics
+
+    rec = as_recording(recording)
+    kw = {"mass": mass, "force_constant": force_constant, "cutoff_hz": cutoff_hz,
+          "controller": controller, "backend": backend}
+    start = fit_inverse_dynamics(rec, sliding=SLIDING, **kw)
+    sig = R.prepare(rec, start, cutoff_hz=cutoff_hz, backend=backend)
+    return fit_base(sig, start, free_mass=mass is None, profiles=profiles)
