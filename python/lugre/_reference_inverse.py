@@ -379,6 +379,20 @@ class InverseRecord:
             return np.zeros((len(self), 0))
         return np.column_stack([self.residual(m) for m in models])
 
+    def fit_base(self, starts: list[ModelLike], mask: Any, names: list[str],
+                 max_iter: int = 60, keep: int = 3, scouts: int = 12,
+                 weighting: str = "huber") -> dict[str, Any]:
+        """The base parameters ``names`` fitted from ``starts`` (twin of the core's
+        ``fit_base``; see ``lugre._reference_basefit``)."""
+        import warnings
+
+        from ._reference_basefit import fit_base
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return fit_base(self, starts, mask, names, max_iter=max_iter, keep=keep,
+                            scouts=scouts, weighting=weighting)
+
     def base_sensitivities(self, model: ModelLike, names: list[str]
                            ) -> tuple[np.ndarray, np.ndarray, list[bool]]:
         """``(force, J, nonzero)``: the LuGre force, its filtered derivatives with respect

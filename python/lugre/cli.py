@@ -348,84 +348,72 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 
 def _cmd_fit(args: argparse.Namespace) -> int:
     from .diagnosis import evaluate, fit_inverse_dynamics, fit_model
+    from .diagnosis.fitreport import identification
     from .model import save_model
 
     effects = [e.strip() for e in (args.effects or "").split(",") if e.strip()]
-
     _check_outputs({"RECORDING": args.recording}, {"--json": args.json, "--html": args.html})
     rec = _read(args, args.recording)
     if rec.F is None and args.force_constant is None:
         raise UsageError.option("--force-constant", f"{args.recording} holds the current i: "
                                 "give the force constant K_F [N/A] with --force-constant")
+    kf = args.force_constant or 1.0
     pr = _progress(args)
-    with pr.step("inverse dynamics (robust least squares)"):
-        model = fit_inverse_dynamics(rec, mass=args.mass,
-                                     force_constant=args.force_constant or 1.0)
-        first = model
-        before = evaluate(rec, model)["nrmse_force"]
-    print(f"inverse dynamics (robust least squares, static friction curve): force nrmse "
-          f"{100 * before:.2f} %")
-    after = None
-    dg = None
-    if not args.no_refine:
-        # refine every base parameter with the bristle state simulated along the measured
-        # velocity (the diagnosis's base re-estimation, with no extra physics)
-        with pr.step("refining with the simulated LuGre state"
-                     + (f" and {', '.join(effects)}" if effects else "")):
-            refined, dg = fit_model(rec, effects=effects, mass=args.mass,
-                                    force_constant=args.force_constant or 1.0)
-            after = evaluate(rec, refined)["nrmse_force"]
-        for f in dg.findings:
-            print(f"{f.effect}: " + ", ".join(f"{k} {v:.4g}" for k, v in f.parameters.items()
-                                               if isinstance(v, float)))
-        missing = [e for e in effects if e not in {f.effect for f in dg.findings}
-                   and not (e in ("delay", "current_lag")
-                            and {"delay", "current_lag"} & {f.effect for f in dg.findings})]
-        for e in missing:
-            print(f"{e}: not supported by this record (no consistent gain on held-out "
-                  "stretches); left out of the model", file=sys.stderr)
-        print(f"refined with the LuGre state simulated along the measured velocity: force "
-              f"nrmse {100 * after:.2f} %")
-        if after < before:
-            model = refined
+    fit = None
+    if args.no_refine:
+        with pr.step("inverse dynamics (robust least squares)"):
+            model = fit_inverse_dynamics(rec, mass=args.mass, force_constant=kf)
+    else:
+        with pr.step("fitting mass and friction to the record"
+                     + (f" with {', '.join(effects)}" if effects else "")):
+            model, fit = fit_model(rec, effects=effects, mass=args.mass, force_constant=kf)
+    nrmse = evaluate(rec, model)["nrmse_force"]
+    print(f"force residual {100 * nrmse:.2f} % of the motor force (rms)"
+          + (" after the inverse-dynamics least squares alone" if fit is None else ""))
+    if fit is not None:
+        _print_fit(fit, effects)
+        model = model.replace(identification=identification(fit, model, nrmse))
     for d in ("positive", "negative"):
         p = getattr(model, d)
         print(f"{d:8s} fc {p['fc']:.4g} N  fs {p['fs']:.4g} N  sigma2 {p['sigma2']:.4g} N s/m  "
               f"vs {p['vs']:.4g} m/s")
     print(f"mass {model.mass:.4g} kg, sigma0 {model.sigma0:.4g} N/m, sigma1 {model.sigma1:.4g} "
           f"N s/m, force constant {model.force_constant:.4g} N/A")
-    from .identify import stribeck_determinacy
-
-    for note in stribeck_determinacy(rec, model):
-        print(f"note: {note}")
-    # sigma0 and sigma1 act in presliding: the refinement frees them only when the record
-    # shows it (held-out test); otherwise they keep the inverse-dynamics guesses
-    base = dg.base if dg is not None and model is not first else {}
-    for k in ("sigma0", "sigma1"):
-        status = base.get(k, {}).get("status", "")
-        if status == "refitted":
-            continue
-        print(f"note: {k} = {getattr(model, k):.4g} {'N/m' if k == 'sigma0' else 'N s/m'} is "
-              "NOT determined by this record (a start guess, held: the record does not show "
-              "the presliding regime at its sampling rate and resolution). Would determine "
-              "it: a presliding record at standstill, an open-loop force sweep below "
-              "break-away (lugre.presliding), or a closed-loop stick-slip record with the "
-              "static sets from constant-velocity runs (lugre fit-static, then lugre "
-              "fit-dynamic)")
     page = None
     if args.html:
         from .html import fit_page
 
         with pr.step("rendering the HTML page"):
             page = fit_page(model.to_dict(), rec, source=args.recording,
-                            nrmse={"inverse dynamics": before, "refined": after},
-                            first=first.to_dict())
+                            nrmse={"fitted model": nrmse})
     save_model(model, args.json)
     print(f"model written to {args.json}")
     if page is not None:
         _write_text(args.html, page)
         print(f"page written to {args.html}")
     return 0
+
+
+def _print_fit(fit: Any, effects: list[str]) -> None:
+    """What the base fit found: the noise floor in words, the effects asked for, what
+    the record leaves open."""
+    from .diagnosis.fitreport import undetermined_notes
+
+    words, far = fit.floor_words()
+    print(("warning: " if far else "") + words, file=sys.stderr if far else sys.stdout)
+    dg = fit.diagnosis
+    if dg is not None:
+        for f in dg.findings:
+            print(f"{f.effect}: " + ", ".join(f"{k} {v:.4g}" for k, v in f.parameters.items()
+                                               if isinstance(v, float)))
+        got = {f.effect for f in dg.findings}
+        for e in effects:
+            if e in got or (e in ("delay", "current_lag") and {"delay", "current_lag"} & got):
+                continue
+            print(f"{e}: not supported by this record (no consistent gain on held-out "
+                  "stretches); left out of the model", file=sys.stderr)
+    for note in undetermined_notes(fit):
+        print(f"note: {note}")
 
 
 def _cmd_paper(args: argparse.Namespace) -> int:
@@ -615,7 +603,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="effects of the vocabulary to identify with the base from the start, "
                          "e.g. resonance,drag (each kept only if the record supports it)")
     ft.add_argument("--no-refine", action="store_true",
-                    help="stop after the inverse-dynamics least squares")
+                    help="stop after the inverse-dynamics least squares (the start of the fit)")
     ft.add_argument("--html", metavar="PAGE.html", help="write a self-contained HTML page")
     recording_options(ft)
     ft.set_defaults(func=_cmd_fit)

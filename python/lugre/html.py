@@ -660,21 +660,47 @@ def static_fit_page(fit: Any, v: Any, F: Any, model: dict[str, Any], *,
     return _page("Static friction fit", "\n".join(body), escape(f"points {source}") if source else "")
 
 
+def _ident_rows(params: dict[str, Any]) -> list[list[str]]:
+    from .diagnosis.fitreport import label
+
+    rows = []
+    for name, p in params.items():
+        unit = str(p.get("unit", ""))
+        lo, hi = (p.get("ci95") or [None, None])
+        ends = [("open" if x is None else f"{float(x):.4g}") for x in (lo, hi)]
+        rows.append([escape(label(name)), escape(f"{float(p['value']):.4g} {unit}"),
+                     escape(f"{ends[0]} to {ends[1]} {unit}"),
+                     "yes" if p.get("determined") else "<b>no</b>"])
+    return rows
+
+
 def fit_page(model: dict[str, Any], rec: Any = None, *, source: str | None = None,
              nrmse: dict[str, float | None] | None = None,
              first: dict[str, Any] | None = None) -> str:
     """``lugre fit``: the identified model, how well it explains the record, its friction
     curve."""
     body = []
-    if nrmse:
-        rows = [[escape(k), f"{100 * float(v):.2f} %"] for k, v in nrmse.items() if v is not None]
+    ident = model.get("identification") or {}
+    if ident.get("summary"):
+        far = bool(ident.get("far_from_floor"))
+        head = "Check first." if far else "Result."
+        body.append(f"<div class=\"verdict{'' if far else ' ok'}\"><b>{head}</b> The identified "
+                    f"model explains the motor force to {100 * float(ident['nrmse_force']):.2f} "
+                    f"% rms; {escape(str(ident['summary']))}.</div>")
+    elif nrmse:
         best = min(v for v in nrmse.values() if v is not None)
         body.append(f"<div class=\"verdict ok\"><b>Result.</b> The identified model explains the "
                     f"motor force to {100 * best:.2f} % rms (force residual over motor force). "
                     "Next: check it on a second run with lugre evaluate, or look for missing "
                     "physics with lugre diagnose.</div>")
+    if nrmse:
+        rows = [[escape(k), f"{100 * float(v):.2f} %"] for k, v in nrmse.items() if v is not None]
         body.append("<h2>Force residual</h2>")
         body.append(_table(["step", "of the motor force (rms)"], rows, {1}))
+    if ident.get("parameters"):
+        body.append("<h2>What the record determines</h2>")
+        body.append(_table(["parameter", "value", "95 % interval", "determined"],
+                           _ident_rows(ident["parameters"]), {1, 2}))
     body.append("<h2>Identified model</h2>")
     body.append(_table(["parameter", "value"], _model_rows(model), {1}))
     v = None

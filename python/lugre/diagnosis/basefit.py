@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -61,6 +62,28 @@ class BaseFitResult:
     n_eff: float
     evaluations: int
     profiles: dict[str, dict[str, Any]] = field(default_factory=dict)
+    diagnosis: Any = None
+
+    @property
+    def floor_ratio(self) -> float:
+        """The residual's rms over the record's noise floor (1: nothing left to fit)."""
+        return self.rms / self.noise if self.noise > 0 else math.inf
+
+    def floor_words(self) -> tuple[str, bool]:
+        """How far the fit is from the record's noise floor, in words, and whether that
+        is far enough to warn."""
+        q = self.floor_ratio
+        head = (f"force residual {self.rms:.3g} N rms against a noise floor of "
+                f"{self.noise:.3g} N ({q:.2g} times)")
+        if q <= 1.5:
+            return head + ": at the record's noise floor, nothing systematic is left", False
+        if q <= 3.0:
+            return (head + ": close to the noise floor; lugre diagnose says whether the "
+                    "rest is physics the model leaves out"), False
+        return (head + ": far from the noise floor, so the record holds something this "
+                "model does not (cogging, a spring, an offset, a resonance, timing, ...): "
+                "run lugre diagnose on this record with this model before relying on "
+                "it"), True
 
 
 def base_names(free_mass: bool) -> list[str]:
@@ -162,7 +185,7 @@ def fit_base(sig: R.Signals, model: Model, *, free_mass: bool, extra: list[Model
                         rms=float(np.sqrt(np.mean(used * used))), noise=float(nf["rms"]),
                         n_eff=float(nf["n_eff"]), evaluations=int(out["evaluations"]))
     if profiles:
-        res.profiles.update(profile_all(sig, res, out["information"]))
+        res = replace(res, profiles=profile_all(sig, res, out["information"]))
     return res
 
 
@@ -268,10 +291,21 @@ def identify(recording: Any, *, mass: float | None = None, force_constant: float
     -------
     BaseFitResult
     """
+    from ..exceptions import PassivityWarning
     from .core import as_recording
+
+    with warnings.catch_warnings():  # the starts and trial models; the result is checked
+        warnings.simplefilter("ignore", PassivityWarning)
+        res = _identify(as_recording(recording), mass, force_constant, cutoff_hz, controller,
+                        backend, profiles)
+    return replace(res, model=Model(res.model.to_dict()))  # warns once if not passive
+
+
+def _identify(rec: Any, mass: float | None, force_constant: float, cutoff_hz: float | None,
+              controller: dict[str, Any] | None, backend: str, profiles: bool
+              ) -> BaseFitResult:
     from .inverse import fit_inverse_dynamics
 
-    rec = as_recording(recording)
     kw = {"mass": mass, "force_constant": force_constant, "cutoff_hz": cutoff_hz,
           "controller": controller, "backend": backend}
     start = fit_inverse_dynamics(rec, sliding=SLIDING, **kw)

@@ -149,14 +149,18 @@ def fit_model(
     force_constant: float = 1.0,
     cutoff_hz: float | None = None,
     screw_lead: float | None = None,
+    backend: str = "core",
 ) -> tuple[Model, Any]:
-    """Identify an axis model from a recording, with extra physics from the start.
+    """Identify an axis model from a recording, with extra physics when asked.
 
-    The base (mass and per-direction LuGre friction) by robust inverse dynamics
-    (:func:`fit_inverse_dynamics`), then every base parameter refined with the bristle
-    state simulated along the measured velocity, jointly with the effects named in
-    ``effects`` (names of the CONTRACT vocabulary). An effect the record does not
-    support is left out and said so in the returned diagnosis (its trials and notes).
+    The base (mass and per-direction LuGre friction) by
+    :func:`lugre.diagnosis.basefit.identify`: the robust inverse-dynamics levels as the
+    start of a robust Levenberg-Marquardt fit of every base parameter on the residual
+    with the bristle state driven by the measured motion, from starts over the Stribeck
+    hump and the bristle stiffness, with each parameter's interval from its profile.
+    Then, when ``effects`` names some, the diagnosis searches those with the base
+    re-estimated alongside; an effect the record does not support is left out and said
+    so in the returned diagnosis (its trials and notes).
 
     Parameters
     ----------
@@ -172,15 +176,21 @@ def fit_model(
         Low-pass cut-off (default ``fs/25``).
     screw_lead : float, optional
         Ball-screw lead [m] (tried for cogging).
+    backend : {"core", "reference"}, default "core"
+        The kernels of the compiled core or of the NumPy twin.
 
     Returns
     -------
     model : Model
         The identified model (base and the effects the record supports).
-    diagnosis : Diagnosis
-        The refit, with the effects' evidence and what the record leaves open.
+    fit : BaseFitResult
+        The base fit: intervals, what the record determines, the residual against its
+        noise floor; ``fit.diagnosis`` the search for ``effects`` (None without).
     """
+    from dataclasses import replace
+
     from ..exceptions import InputError
+    from .basefit import identify
     from .core import diagnose
     from .effects import candidates
 
@@ -193,11 +203,14 @@ def fit_model(
     if "current_lag" in wanted and "delay" not in wanted:
         wanted.append("delay")  # one timing candidate; its form is chosen by the record
     rec = as_recording(recording)
-    base = fit_inverse_dynamics(rec, mass=mass, force_constant=force_constant,
-                                cutoff_hz=cutoff_hz)
-    dg = diagnose(rec, base, candidates=wanted, free_mass=mass is None, cutoff_hz=cutoff_hz,
-                  screw_lead=screw_lead, closed_loop=False, tolerance=IDENTIFY_TOLERANCE)
+    res = identify(rec, mass=mass, force_constant=force_constant, cutoff_hz=cutoff_hz,
+                   backend=backend)
+    if not wanted:
+        return res.model, res
+    dg = diagnose(rec, res.model, candidates=wanted, free_mass=mass is None,
+                  cutoff_hz=cutoff_hz, screw_lead=screw_lead, closed_loop=False,
+                  tolerance=IDENTIFY_TOLERANCE, backend=backend)
     model = dg.augmented_model()
     if mass is not None:
         model = model.replace(axis={**model.axis, "mass": float(mass)})
-    return model, dg
+    return model, replace(res, diagnosis=dg)

@@ -1,0 +1,82 @@
+"""The base fit in words and in the model file: each parameter with its interval, what
+the record does not determine and what would."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from ..model import Model
+from .basefit import BaseFitResult
+
+__all__ = ["identification", "label", "undetermined_notes"]
+
+_UNITS = {"mass": "kg", "fc": "N", "hump": "N", "sigma2": "N s/m", "vs": "m/s",
+          "sigma0": "N/m", "sigma1": "N s/m"}
+
+#: What would determine a parameter the record leaves open.
+_WOULD = {
+    "mass": "faster changes of speed (accelerations well above the friction's noise)",
+    "fc": "sliding at steady speeds in this direction",
+    "hump": "slow motion through the Stribeck range, with reversals and break-away",
+    "vs": "motion at speeds around the Stribeck speed (slow sweeps, reversals)",
+    "sigma2": "sliding over a wider range of speeds",
+    "sigma0": "the presliding regime: an open-loop force sweep at standstill below "
+              "break-away (lugre.presliding), or a record sampled fast enough to resolve "
+              "the bristles' spring",
+    "sigma1": "the presliding regime (as sigma0), or a closed-loop stick-slip record with "
+              "the static sets from constant-velocity runs (lugre fit-static, then "
+              "lugre fit-dynamic)",
+}
+
+
+def _key(name: str) -> str:
+    return name.split(".")[-1]
+
+
+def label(name: str) -> str:
+    """``positive.hump`` -> ``fs - fc (v >= 0)``."""
+    side, _, key = name.rpartition(".")
+    text = "fs - fc" if key == "hump" else key
+    return f"{text} ({'v >= 0' if side == 'positive' else 'v < 0'})" if side else text
+
+
+def _num(x: Any) -> float | None:
+    return None if x is None or not math.isfinite(float(x)) else float(x)
+
+
+def identification(fit: BaseFitResult, model: Model, nrmse: float) -> dict[str, Any]:
+    """The ``identification`` section of a fitted model file: the fit against the
+    record's noise floor and every fitted parameter with its 95 % interval."""
+    params = {}
+    for name, p in fit.profiles.items():
+        ci = p.get("ci95") or [None, None]
+        params[name] = {"value": float(p["value"]), "unit": _UNITS[_key(name)],
+                        "ci95": [_num(ci[0]), _num(ci[1])],
+                        "determined": bool(p["determined"]), "how": p["how"]}
+    words, far = fit.floor_words()
+    return {"nrmse_force": float(nrmse), "rms_force": fit.rms, "noise_floor": fit.noise,
+            "floor_ratio": fit.floor_ratio, "far_from_floor": far, "summary": words,
+            "parameters": params}
+
+
+def undetermined_notes(fit: BaseFitResult) -> list[str]:
+    """One sentence per parameter the record does not determine."""
+    out = []
+    for name, p in fit.profiles.items():
+        if p["determined"]:
+            continue
+        key = _key(name)
+        val = f"{p['value']:.4g} {_UNITS[key]}"
+        if p["how"] == "no hump":
+            out.append(f"{label(name)} = {val} is NOT determined: the fit found no Stribeck "
+                       "hump in this direction (fs = fc), so vs does nothing. Would show a "
+                       f"hump: {_WOULD['hump']}")
+            continue
+        lo, hi = (p.get("ci95") or [None, None])
+        side = ("either way" if lo is None and hi is None else
+                "upwards" if hi is None else "downwards")
+        out.append(f"{label(name)} = {val} is NOT determined by this record: moved "
+                   f"{side} by up to a factor of ten (the others refitted) the fit stays "
+                   f"within the noise. Would determine it: {_WOULD[key]}")
+    return out
