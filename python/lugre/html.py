@@ -284,7 +284,8 @@ def _verdict(report: dict[str, Any]) -> tuple[str, bool]:
     """The verdict paragraph (the report's own when it has one) and whether all is well."""
     findings = report.get("findings") or []
     fit = report.get("fit") or {}
-    ok = not findings and not report.get("unexplained") and not report.get("removed")
+    ok = (not findings and not report.get("unexplained") and not report.get("removed")
+          and not report.get("rebased"))
     if report.get("verdict"):
         return str(report["verdict"]), ok
     hold = fit.get("holdout_before") and fit.get("holdout_after")
@@ -494,6 +495,18 @@ def diagnosis_page(report: dict[str, Any], data: dict[str, Any] | None = None, *
         body.append(_p("No effect beyond noise was found."))
     for k, f in enumerate(findings, 1):
         body.append(_finding_section(k, f, data, floor))
+
+    rebased = report.get("rebased")
+    if isinstance(rebased, dict) and rebased.get("moves"):
+        body.append("<h2>Base refitted first</h2>")
+        body.append(_p("The base of the model as given is far from what this record "
+                       "supports; the search ran from the refitted base, so that no finding "
+                       "stands in for a base parameter."))
+        rows = [[escape(str(m.get("name"))), escape(f"{float(m.get('given', 0)):.4g}"),
+                 escape(f"{float(m.get('refit', 0)):.4g}"),
+                 escape(f"{100 * float(m.get('change', 0)):+.0f} %")]
+                for m in rebased["moves"] if isinstance(m, dict)]
+        body.append(_table(["parameter", "as given", "refitted", "change"], rows, {1, 2, 3}))
 
     removed = [r for r in (report.get("removed") or []) if isinstance(r, dict)]
     if removed:

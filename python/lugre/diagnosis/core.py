@@ -18,6 +18,7 @@ from . import effects as E
 from . import evidence as V
 from . import residual as R
 from .locate import locate, position_spectrum
+from .rebase import far_base
 from .refit import refine, split
 from .report import Diagnosis, Finding
 from .search import (
@@ -274,12 +275,24 @@ def diagnose(
     """
     t_start = time.perf_counter()
     model = _as_model(model)  # (warns once if the model given is not passive)
+    rec = as_recording(recording)
+    kw = {"holdout": holdout, "cutoff_hz": cutoff_hz, "blocks": blocks, "alpha": alpha,
+          "min_gain": min_gain, "closed_loop": closed_loop, "candidates": candidates,
+          "screw_lead": screw_lead, "free_mass": free_mass, "tolerance": tolerance,
+          "backend": backend}
     with warnings.catch_warnings():  # the trial models of the search and the refits
         warnings.simplefilter("ignore", PassivityWarning)
-        dg = _diagnose(recording, model, holdout=holdout, cutoff_hz=cutoff_hz, blocks=blocks,
-                       alpha=alpha, min_gain=min_gain, closed_loop=closed_loop,
-                       candidates=candidates, screw_lead=screw_lead, free_mass=free_mass,
-                       tolerance=tolerance, backend=backend)
+        dg = _diagnose(rec, model, **kw)
+        # the base is a starting point: when the record puts it far from where it was
+        # given, the search runs again from where the record puts it
+        far = None if candidates is not None else far_base(
+            rec, model, dg.augmented, cutoff_hz=cutoff_hz, backend=backend,
+            free_mass=free_mass)
+        if far is not None:
+            dg = _diagnose(rec, far["model"], **kw)
+            dg.model = model
+            dg.rebased = {k: v for k, v in far.items() if k != "model"}
+            dg.verdict = V.verdict(dg)
     if model.is_passive and not dg.augmented.is_passive:
         warnings.warn(
             "the augmented model's sigma1 exceeds the passivity bound 4*sigma2*fc/(fs - fc) "

@@ -817,8 +817,10 @@ def verdict(dg: Any) -> str:
                      "(an unstable or saturated stretch, another setup or temperature) "
                      "before using the augmented model.")
     gone = getattr(dg, "removed", [])
+    rebased = getattr(dg, "rebased", None)
+    head = (rebased["text"][0].upper() + rebased["text"][1:] + ". ") if rebased else ""
     if not gone:
-        return _verdict_findings(dg, gain)
+        return head + _verdict_findings(dg, gain)
     # the model's own effects that the record contradicts come first: they are what the
     # user wrote, and the augmented model leaves them out
     def listed(rs: list[dict[str, Any]], who: str = "its") -> str:
@@ -838,7 +840,7 @@ def verdict(dg: Any) -> str:
                    "again without it, the record holds another of its kind (below), which "
                    "replaces it.")
     one = len(gone) == 1
-    return " ".join(out) + " " + _verdict_findings(dg, gain,
+    return head + " ".join(out) + " " + _verdict_findings(dg, gain,
                                                    f"without {'it' if one else 'them'}")
 
 

@@ -138,6 +138,10 @@ class Diagnosis:
     #: effects of the model as given that the record contradicts: left out of the
     #: augmented model; each ``effect``, ``parameters``, ``evidence`` and the block test
     removed: list[dict[str, Any]] = field(default_factory=list)
+    #: set when the base as given was far from what the record supports and the search
+    #: ran from the refitted base: ``moves`` (``name``, ``given``, ``refit``, ``change``),
+    #: ``rms_given``, ``rms_refit`` [N], ``text``
+    rebased: dict[str, Any] | None = None
 
     def augmented_model(self) -> Model:
         """The model with the findings added to ``effects`` and the base re-estimated."""
@@ -158,6 +162,7 @@ class Diagnosis:
             "could_not_reveal": _plain(self.could_not_reveal),
             "minor": _plain(self.minor),
             "removed": _plain(self.removed),
+            "rebased": _plain(self.rebased),
             "trials": [
                 {k: _plain(v) for k, v in t.items() if k in (
                     "step", "effect", "gain", "p", "positive", "contrib", "accepted", "why")}
@@ -199,6 +204,8 @@ class Diagnosis:
                 f"{cl['after']['rms_position'] * 1e6:.3g} um rms, current "
                 f"{cl['before']['rms_current']:.3g} A -> {cl['after']['rms_current']:.3g} A rms."
             )
+        if self.rebased:
+            lines.append(f"Base refitted: {self.rebased['text']}.")
         for r in self.removed:
             what = "Replaced in the model" if r.get("replaced") else "Removed from the model"
             lines.append(f"{what}: {r['effect']}. {plain_text(r['evidence'])}")

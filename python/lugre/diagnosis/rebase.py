@@ -1,0 +1,100 @@
+"""The base as a starting point, not as the truth: after the search, the base is refitted
+with the findings in; when that moves it far from the model as given (beyond three
+tolerances) and lowers the residual by a fifth or more, the given base was far from what
+the record supports, and the diagnosis is run again from the refitted base, so that no
+finding stands in for a base parameter."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..model import Model
+from . import residual as R
+from .base import BASE_PARAMS, apply_base
+from .basefit import _run, _value, base_names, fit_base
+
+__all__ = ["REBASE_GAIN", "REBASE_TOLERANCES", "far_base"]
+
+#: Least share of the residual's rms the refit must remove ...
+REBASE_GAIN = 0.2
+#: ... while moving a base parameter by more than this many of its tolerances.
+REBASE_TOLERANCES = 3.0
+
+_TOL = dict(BASE_PARAMS)
+
+
+def _tolerance(name: str) -> float:
+    return _TOL.get(name.replace(".hump", ".fs"), 0.03)
+
+
+def _rms(r: np.ndarray, mask: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(r[mask] ** 2)))
+
+
+def far_base(rec: Any, given: Model, augmented: Model, *, cutoff_hz: float | None,
+             backend: str, free_mass: bool) -> dict[str, Any] | None:
+    """Whether the given base is far from what the record supports.
+
+    Returns None, or ``model`` (the given model with its base refitted from the grid of
+    starts, its own effects kept), ``moves`` (per parameter moved beyond the tolerances:
+    ``name``, ``given``, ``refit``, ``change``), ``rms_given`` and ``rms_refit`` [N]
+    (the augmented model's residual before and after the quick refit) and ``text``.
+    """
+    sig = R.prepare(rec, augmented, cutoff_hz=cutoff_hz, backend=backend)
+    names = base_names(free_mass)
+    quick, _ = _run(sig, [augmented], names, keep=1, max_iter=30)
+    r0 = np.asarray(sig.kernel.residual(augmented))
+    r1 = np.asarray(sig.kernel.residual(quick))
+    rms0, rms1 = _rms(r0, sig.mask), _rms(r1, sig.mask)
+    if not rms1 < (1.0 - REBASE_GAIN) * rms0:
+        return None
+    moved = _moves(given, quick, names)
+    if not moved:
+        return None
+    # the given model's own effects, its base fitted from the grid (and the quick refit)
+    sig_g = R.prepare(rec, given, cutoff_hz=cutoff_hz, backend=backend)
+    quick_g = apply_base(given, {n: v for n, v in _base_values(quick).items()})
+    full = fit_base(sig_g, given, free_mass=free_mass, extra=[quick_g], profiles=False)
+    moves = _moves(given, full.model, names) or moved
+    text = ("the base as given is far from what this record supports: "
+            + ", ".join(_move_words(m) for m in moves)
+            + f"; refitted with the findings in, the force residual falls from {rms0:.3g} "
+            f"to {rms1:.3g} N rms. The search was run again from the refitted base, so "
+            "that no finding stands in for a base parameter")
+    return {"model": full.model, "moves": moves, "rms_given": rms0, "rms_refit": rms1,
+            "text": text}
+
+
+def _base_values(m: Model) -> dict[str, float]:
+    out = {"mass": float(m.mass), "sigma0": float(m.sigma0), "sigma1": float(m.sigma1)}
+    for d in ("positive", "negative"):
+        for k in ("fc", "fs", "sigma2", "vs"):
+            out[f"{d}.{k}"] = float(m.friction[d][k])
+    return out
+
+
+def _moves(given: Model, refit: Model, names: list[str]) -> list[dict[str, Any]]:
+    out = []
+    for n in names:
+        a, b = _value(given, n), _value(refit, n)
+        if n.endswith(".hump"):
+            fc = _value(given, n.replace(".hump", ".fc"))
+            change = (b - a) / max(fc, 1e-12)
+        else:
+            change = (b - a) / max(abs(a), 1e-12)
+        if abs(change) > REBASE_TOLERANCES * _tolerance(n):
+            out.append({"name": n, "given": a, "refit": b, "change": change})
+    return out
+
+
+_UNITS = {"mass": "kg", "fc": "N", "hump": "N", "sigma2": "N s/m", "vs": "m/s",
+          "sigma0": "N/m", "sigma1": "N s/m"}
+
+
+def _move_words(m: dict[str, Any]) -> str:
+    from .fitreport import label
+
+    unit = _UNITS[m["name"].split(".")[-1]]
+    return f"{label(m['name'])} {m['given']:.4g} -> {m['refit']:.4g} {unit}"
