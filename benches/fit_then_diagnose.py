@@ -36,7 +36,7 @@ def main() -> None:
                "--json", str(o / "fitted.json")]
         if a.mass:
             cmd += ["--mass", str(believed["axis"]["mass"])]
-        r = subprocess.run(cmd, capture_output=True, text=True)
+        r = subprocess.run(cmd, capture_output=True, text=True, check=False)
         if r.returncode:
             print(f"{d.name}: fit failed: {r.stderr.strip()}", flush=True)
             continue

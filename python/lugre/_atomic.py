@@ -8,6 +8,38 @@ from pathlib import Path
 
 __all__ = ["atomic_write"]
 
+#: Where ``-`` is written (None: ``sys.stdout``); the command line sets it while its
+#: own lines go to standard error.
+STDOUT = None
+
+
+def _write_through(path: str | os.PathLike[str], data: bytes) -> bool:
+    """Write ``data`` through to standard output (``-``) or to an existing file that is
+    not a regular one (a device such as ``/dev/null``, a FIFO, a socket): such a path is
+    never replaced. True when written so."""
+    import stat
+    import sys
+
+    if os.fspath(path) == "-":
+        stream = STDOUT if STDOUT is not None else sys.stdout
+        out = getattr(stream, "buffer", None)
+        if out is None:
+            stream.write(data.decode("utf-8"))
+        else:
+            stream.flush()
+            out.write(data)
+        stream.flush()
+        return True
+    try:
+        mode = os.stat(path).st_mode
+    except (FileNotFoundError, NotADirectoryError):
+        return False
+    if stat.S_ISREG(mode) or stat.S_ISDIR(mode):
+        return False
+    with open(path, "wb") as fh:
+        fh.write(data)
+    return True
+
 
 def atomic_write(path: str | os.PathLike[str], data: bytes) -> None:
     """Write ``data`` to ``path`` whole or not at all.
@@ -15,8 +47,11 @@ def atomic_write(path: str | os.PathLike[str], data: bytes) -> None:
     The bytes go to a temporary file in the destination's directory, are flushed to
     disk, and the temporary file then replaces ``path`` (:func:`os.replace` is atomic
     within one file system). On any error the temporary file is removed and ``path`` is
-    left as it was.
+    left as it was. ``-`` (standard output), a device, a FIFO or another special file is
+    written through, never replaced (``--json /dev/null`` throws the output away).
     """
+    if _write_through(path, data):
+        return
     dest = Path(path)
     directory = dest.parent if str(dest.parent) else Path(".")
     if not directory.is_dir():

@@ -625,6 +625,24 @@ def _show_warning(message: Any, category: Any, filename: str, lineno: int,
     print(f"warning: {text}", file=sys.stderr)
 
 
+def _run_command(args: argparse.Namespace) -> int:
+    """Run the command; when an output is ``-`` (standard output) the progress and
+    summary lines go to standard error, so that the output stays whole."""
+    from . import _atomic
+
+    outs = [getattr(args, k, None) for k in ("json", "html", "out_model")]
+    if "-" not in outs:
+        return int(args.func(args))
+    saved = sys.stdout
+    _atomic.STDOUT = saved
+    sys.stdout = sys.stderr
+    try:
+        return int(args.func(args))
+    finally:
+        sys.stdout = saved
+        _atomic.STDOUT = None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``lugre`` command; returns the exit status."""
     parser = build_parser()
@@ -636,7 +654,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         warnings.simplefilter("default")
         warnings.showwarning = _show_warning
         try:
-            return int(args.func(args))
+            return _run_command(args)
         except UsageError as e:
             print(f"lugre {args.command}: error: {e}", file=sys.stderr)
             return 2

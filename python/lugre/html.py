@@ -213,17 +213,48 @@ _TIMING_LABELS = {("delay", "seconds"): "effective delay",
                   ("current_lag", "seconds"): "effective delay"}
 
 
+def _is_num(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _ranges_text(r: Any, unit: tuple[str, float]) -> str | None:
+    """A ``[lo, hi]`` range, or a list of them (several stretches), in words."""
+    if isinstance(r, (list, tuple)) and len(r) == 2 and all(
+            x is None or _is_num(x) for x in r):
+        return U.fmt_range(r[0], r[1], unit)
+    if isinstance(r, (list, tuple)) and r and all(
+            isinstance(x, (list, tuple)) and len(x) == 2 and all(_is_num(y) for y in x)
+            for x in r):
+        parts = [U.fmt_range(a, b, unit) for a, b in r]
+        if len(parts) > 4:
+            return (f"{len(parts)} stretches between "
+                    f"{U.fmt_range(r[0][0], r[-1][1], unit)}")
+        return ", ".join(parts)
+    return None
+
+
+def _direction_text(d: dict[str, Any]) -> str | None:
+    """Where the rest is largest among moving forward, back and at rest (force rms)."""
+    words = {"positive": "moving forward", "negative": "moving back", "rest": "at rest"}
+    vals = [(words[k], float(v)) for k, v in d.items() if k in words and _is_num(v)]
+    if not vals:
+        return None
+    return ", ".join(f"{w} {v:.3g} N rms" for w, v in vals)
+
+
 def _where_text(where: dict[str, Any] | None) -> str:
-    if not where:
+    if not isinstance(where, dict) or not where:
         return "everywhere in the record (not confined)"
     parts = []
     for key in ("position", "time", "velocity"):
-        r = where.get(key)
-        if isinstance(r, (list, tuple)) and len(r) == 2:
-            parts.append(f"{key} {U.fmt_range(r[0], r[1], U.WHERE_UNITS[key])}")
-    extra = [k for k in where if k not in ("position", "time", "velocity") and where[k]]
-    for k in extra:
-        parts.append(f"{k} {where[k]}")
+        txt = _ranges_text(where.get(key), U.WHERE_UNITS[key])
+        if txt:
+            parts.append(f"{key} {txt}")
+    d = where.get("direction")
+    if isinstance(d, dict):
+        txt = _direction_text(d)
+        if txt:
+            parts.append(f"residual {txt}")
     return "; ".join(parts) if parts else "everywhere in the record (not confined)"
 
 

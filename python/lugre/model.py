@@ -31,7 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Union
 
-from .exceptions import ModelError, ParameterError, PassivityWarning
+from .exceptions import InputError, ModelError, ParameterError, PassivityWarning
 
 __all__ = ["Model", "ModelLike", "load_model", "save_model"]
 
@@ -919,6 +919,9 @@ def save_model(model: ModelLike, path: str | os.PathLike[str]) -> None:
     """
     from ._atomic import _atomic_write
 
+    if isinstance(model, (str, os.PathLike)) and not isinstance(path, (str, os.PathLike)):
+        raise InputError.at("model", f"got the path {os.fspath(model)!r} first: save_model "
+                            "takes the model first, then the path: save_model(model, path)")
     m = _as_model(model)
     text = m.to_json(indent=2) + "\n"
     _atomic_write(path, text.encode("utf-8"))

@@ -381,8 +381,13 @@ def read_recording(path: str | os.PathLike[str], columns: ColumnSpec = None, *,
     return Recording(**found, meta=meta, source=p)
 
 
-def write_recording(path: str | os.PathLike[str], rec: Recording) -> None:
+def write_recording(path: Any, rec: Any) -> None:
     """Write a recording atomically (whole or not at all).
+
+    The two arguments may come in either order (``write_recording(rec, path)``, as
+    :func:`lugre.save_model`, or ``write_recording(path, rec)``): one is a
+    :class:`Recording` (or a simulation result, see :meth:`Recording.from_simulation`),
+    the other the path.
 
     Parameters
     ----------
@@ -393,8 +398,16 @@ def write_recording(path: str | os.PathLike[str], rec: Recording) -> None:
     rec : Recording
         The recording. ``.mat`` files do not keep ``meta``.
     """
+    if isinstance(path, Recording) or hasattr(path, "friction"):
+        path, rec = rec, path
+    if hasattr(rec, "friction") and hasattr(rec, "x") and not isinstance(rec, Recording):
+        rec = Recording.from_simulation(rec)
     if not isinstance(rec, Recording):
-        raise TypeError(f"expected a lugre.io.Recording, got {type(rec).__name__}")
+        raise InputError.at("rec", f"expected a lugre.Recording, got {type(rec).__name__}: "
+                            "write_recording(recording, path)")
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError.at("path", f"expected a file path, got {type(path).__name__}: "
+                            "write_recording(recording, path)")
     cols = rec.columns
     suffix = Path(os.fspath(path)).suffix.lower()
     if suffix == ".npz":

@@ -128,6 +128,44 @@ class Recording:
             )
         self.meta = dict(self.meta)
 
+    @classmethod
+    def from_simulation(cls, result: Any, *, x_ref: Any = None, v_ref: Any = None,
+                        current_noise: float = 0.0, quantum: float = 0.0,
+                        seed: int | None = None) -> Recording:
+        """A recording of a simulated axis, as a drive would log it.
+
+        Parameters
+        ----------
+        result : SimulationResult
+            What :func:`lugre.simulate` returned (its ``t``, ``x`` and current ``i``).
+        x_ref, v_ref : array_like, optional
+            The reference the loop followed, kept as a column.
+        current_noise : float, default 0
+            Standard deviation of white noise added to the current [A].
+        quantum : float, default 0
+            Encoder resolution [m]: positions rounded to it (0: exact).
+        seed : int, optional
+            Seed of the noise.
+
+        Examples
+        --------
+        >>> import numpy as np, lugre
+        >>> t = np.arange(0, 0.01, 1e-4)
+        >>> r = lugre.simulate(lugre.Model.paper(), t, x_ref=0.01 * t)
+        >>> len(lugre.Recording.from_simulation(r, x_ref=0.01 * t, quantum=1e-6))
+        100
+        """
+        x = np.asarray(result.x, dtype=float)
+        if quantum < 0 or current_noise < 0:
+            raise InputError.at("quantum" if quantum < 0 else "current_noise",
+                                "must be zero or positive")
+        if quantum > 0:
+            x = np.round(x / quantum) * quantum
+        i = np.asarray(result.i, dtype=float)
+        if current_noise > 0:
+            i = i + current_noise * np.random.default_rng(seed).standard_normal(i.size)
+        return cls(t=np.asarray(result.t, dtype=float), x=x, i=i, x_ref=x_ref, v_ref=v_ref)
+
     @property
     def columns(self) -> tuple[str, ...]:
         """Names of the columns present, in :data:`COLUMNS` order."""

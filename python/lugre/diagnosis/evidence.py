@@ -204,9 +204,15 @@ def base_report(model: Model, base: dict[str, float], free: list[str],
 
 
 def base_moves(base: dict[str, dict[str, Any]], factor: float = 2.0) -> list[dict[str, Any]]:
-    """Base parameters that moved by more than ``factor`` tolerances, in words."""
+    """Base parameters that moved by more than ``factor`` tolerances, in words. A damping
+    driven to zero (the record does not resolve it) and a value that is numerically zero
+    before and after are no moves."""
     out = []
     for n, b in base.items():
+        if n in ("sigma1", "positive.sigma2", "negative.sigma2") and b["after"] == 0.0:
+            continue
+        if max(abs(b["before"]), abs(b["after"])) < 1e-12:
+            continue
         if abs(b["change"]) > factor * b["tolerance"]:
             d = b["after"] - b["before"]
             out.append({"parameter": n, "before": b["before"], "after": b["after"],
@@ -617,11 +623,12 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
                 out.append(_hide("delay/current_lag", b, "s",
                                  f"a delay or current lag {_under(b * 1e3, '{:.2g} ms')}"))
             elif e == "drift":
-                b = size((sig.t / max(sig.t[-1], 1e-9)) * ctx.fcs, e)
+                b = _share(size((sig.t / max(sig.t[-1], 1e-9)) * ctx.fcs, e))
                 out.append(_hide(e, b, "-", f"a friction drift {_under(100 * b, '{:.2g} %')} over the "
                                  "record"))
             elif e == "position_friction":
-                b = size(sig.filt(ctx.fcs * (np.abs(sig.x - np.mean(sig.x)) < 0.1 * span)), e)
+                b = _share(size(sig.filt(ctx.fcs * (np.abs(sig.x - np.mean(sig.x))
+                                                    < 0.1 * span)), e))
                 out.append(_hide(e, b, "-", f"a friction change {_under(100 * b, '{:.2g} %')} over a "
                                  "tenth of the stroke"))
             elif e in ("stribeck_shape", "deadband", "resonance"):
@@ -725,6 +732,12 @@ def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
         rms = float(np.sqrt(np.mean(xm * xm))) if xm.size else 0.0
         out[j] = max(size, min_rms / rms) if rms > 0 else np.inf
     return out
+
+
+def _share(b: float) -> float:
+    """A relative size: one the friction itself would have to change sign to reach (100 %
+    or more) is no size the record reveals."""
+    return b if b < 1.0 else float("inf")
 
 
 def _under(b: float, fmt: str) -> str:
@@ -859,8 +872,11 @@ def _verdict_findings(dg: Any, gain: str, without: str = "") -> str:
         return txt + gain
     names = ", ".join(f"{f.effect} ({_params(f)})" for f in dg.findings)
     one = len(dg.findings) == 1
-    txt = (f"Found: {names}.{gain} Add {'it' if one else 'them'} to the model (the augmented "
-           f"model has {'it' if one else 'them'}).")
+    if "does not carry over" in gain:  # the advice is already given: check first
+        txt = f"Found on this record: {names}.{gain}"
+    else:
+        txt = (f"Found: {names}.{gain} Add {'it' if one else 'them'} to the model (the "
+               f"augmented model has {'it' if one else 'them'}).")
     if any(f.alternatives for f in dg.findings):
         txt += " Some have a look-alike this record cannot rule out: see each finding."
     if dg.unexplained:

@@ -177,6 +177,8 @@ class Diagnosis:
 
     def summary(self) -> str:
         """A plain-text report for a control engineer."""
+        from .evidence import effect_words
+
         lines: list[str] = [self.verdict] if self.verdict else []
         fb, fa = self.fit["before"], self.fit["after"]
         after = self.noise.get("rms_after")
@@ -239,8 +241,8 @@ class Diagnosis:
             lines.append(
                 "Minor corrections, consistent on the held-out stretches but each under "
                 "0.3 % of the motor force (kept in the augmented model, too small to name): "
-                + "; ".join(f"{m['effect']} {_fmt({k: v for k, v in m['parameters'].items() if not isinstance(v, list)})} ({m['rms_force']:.2g} N rms)"
-                            for m in self.minor) + ".")
+                + "; ".join(f"{m['effect']} ({effect_words(m['effect'], m['parameters'])}; "
+                            f"{m['rms_force']:.2g} N rms)" for m in self.minor) + ".")
         moved = [f"{n} {100 * b['change']:+.1f} %" for n, b in self.base.items()
                  if abs(b["change"]) > 0.005]
         if moved:
