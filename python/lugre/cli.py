@@ -377,8 +377,9 @@ def _cmd_fit(args: argparse.Namespace) -> int:
         p = getattr(model, d)
         print(f"{d:8s} fc {p['fc']:.4g} N  fs {p['fs']:.4g} N  sigma2 {p['sigma2']:.4g} N s/m  "
               f"vs {p['vs']:.4g} m/s")
+    kf_txt = (f", force constant {model.force_constant:.4g} N/A" if rec.F is None else "")
     print(f"mass {model.mass:.4g} kg, sigma0 {model.sigma0:.4g} N/m, sigma1 {model.sigma1:.4g} "
-          f"N s/m, force constant {model.force_constant:.4g} N/A")
+          f"N s/m{kf_txt}")
     page = None
     if args.html:
         from .html import fit_page

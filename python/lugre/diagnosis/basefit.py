@@ -186,13 +186,80 @@ def fit_base(sig: R.Signals, model: Model, *, free_mass: bool, extra: list[Model
                         n_eff=float(nf["n_eff"]), evaluations=int(out["evaluations"]))
     if profiles:
         res = replace(res, profiles=profile_all(sig, res, out["information"]))
+        res = simplest(sig, res)
     return res
+
+
+def simplest(sig: R.Signals, res: BaseFitResult) -> BaseFitResult:
+    """Where the record leaves a parameter open, the simplest value it allows: a hump
+    that the noise allows down to zero is zero (fs = fc; a break-away of ten times the
+    Coulomb level on a handful of samples is no finding), and a damping sigma1 it does
+    not determine is held within the passivity bound. The others are refitted."""
+    prof = dict(res.profiles)
+    vals: dict[str, float] = {}
+    held: list[str] = []
+    for d in SIDES:
+        p = prof.get(f"{d}.hump")
+        if p and not p["determined"] and p["value"] > 0 and (p.get("ci95") or [None])[0] in (
+                None, 0.0):
+            vals[f"{d}.fs"] = get_base(res.model, f"{d}.fc")
+            held += [f"{d}.hump", f"{d}.vs"]
+    s1 = prof.get("sigma1")
+    if s1 and not s1["determined"]:
+        bound = _passive_sigma1(apply_base(res.model, vals))
+        if get_base(res.model, "sigma1") > bound:
+            vals["sigma1"] = 0.5 * bound
+            held.append("sigma1")
+    if not vals:
+        return res
+    names = [n for n in res.names if n not in held]
+    fitted, _ = _run(sig, [apply_base(res.model, vals)], names, keep=1, max_iter=30)
+    for n in res.names:
+        prof[n] = {**prof[n], "value": _value(fitted, n)}
+    for n in held:
+        prof[n] = {**prof[n], "how": "held (simplest)", "determined": False}
+    r = np.asarray(sig.kernel.residual(fitted))[sig.mask]
+    return replace(res, model=fitted, profiles=prof, rms=float(np.sqrt(np.mean(r * r))))
+
+
+def _passive_sigma1(m: Model) -> float:
+    """The largest sigma1 that keeps both directions passive (Barabanov & Ortega 2000)."""
+    out = math.inf
+    for d in SIDES:
+        st = m.friction[d]
+        hump = float(st["fs"]) - float(st["fc"])
+        if hump > 0:
+            out = min(out, 4.0 * float(st["sigma2"]) * float(st["fc"]) / hump)
+    return out
 
 
 def _chi2(sig: R.Signals, model: Model, q0: float, cut: float, s2: float, ratio: float) -> float:
     r = np.asarray(sig.kernel.residual(model))[sig.mask]
     q = float(np.sum(np.minimum(r * r, cut)))
     return (q - q0) / s2 * ratio
+
+
+def _covariance(info: np.ndarray) -> np.ndarray:
+    """The inverse of the information, scaled to unit diagonal first; a direction the
+    record does not inform (a near-singular information) gives its parameters an
+    infinite variance, not the small one a pseudo-inverse would."""
+    d = np.sqrt(np.clip(np.diag(info), 0.0, None))
+    q = info.shape[0]
+    out = np.full((q, q), np.inf)
+    ok = d > 0
+    if not ok.any():
+        return out
+    sub = info[np.ix_(ok, ok)] / np.outer(d[ok], d[ok])
+    w, V = np.linalg.eigh(sub)
+    inv_w = np.where(w > 1e-10 * max(float(w.max()), 1e-300), 1.0 / np.maximum(w, 1e-300),
+                     np.inf)
+    with np.errstate(invalid="ignore"):
+        c = (V * inv_w) @ V.T
+        # a parameter with a share in an uninformed direction gets an infinite variance
+        var = (V ** 2) @ inv_w
+    c[np.diag_indices_from(c)] = var
+    out[np.ix_(ok, ok)] = c / np.outer(d[ok], d[ok])
+    return out
 
 
 def profile_all(sig: R.Signals, res: BaseFitResult, info: np.ndarray) -> dict[str, dict[str, Any]]:
@@ -207,11 +274,7 @@ def profile_all(sig: R.Signals, res: BaseFitResult, info: np.ndarray) -> dict[st
     cut = (2.5 * res.scale) ** 2
     r0 = np.asarray(sig.kernel.residual(best))[sig.mask]
     q0 = float(np.sum(np.minimum(r0 * r0, cut)))
-    info = np.asarray(info, dtype=float)
-    try:
-        cov = np.linalg.pinv(info) * s2 / ratio
-    except np.linalg.LinAlgError:  # pragma: no cover - pinv converges
-        cov = np.full_like(info, np.inf)
+    cov = _covariance(np.asarray(info, dtype=float)) * s2 / ratio
     out: dict[str, dict[str, Any]] = {}
     for k, name in enumerate(names):
         val = _value(best, name)

@@ -68,6 +68,13 @@ def undetermined_notes(fit: BaseFitResult) -> list[str]:
             continue
         key = _key(name)
         val = f"{p['value']:.4g} {_UNITS[key]}"
+        if p["how"] == "held (simplest)":
+            what = ("set to zero (fs = fc)" if key == "hump" else "held within the passivity "
+                    "bound" if key == "sigma1" else "held: without a hump it does nothing")
+            out.append(f"{label(name)} = {val} is NOT determined by this record and is "
+                       f"{what}: the fit is as good within the noise. Would determine it: "
+                       f"{_WOULD[key]}")
+            continue
         if p["how"] == "no hump":
             out.append(f"{label(name)} = {val} is NOT determined: the fit found no Stribeck "
                        "hump in this direction (fs = fc), so vs does nothing. Would show a "
