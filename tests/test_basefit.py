@@ -1,0 +1,179 @@
+"""The base fit (``lugre fit``): the record's own optimum from the tool's starts, on
+records written by a plant independent of the package, with honest intervals; the core
+and its NumPy twin on the same inputs."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import lugre
+from lugre.diagnosis import evaluate
+from lugre.diagnosis import residual as R
+from lugre.diagnosis.basefit import base_names, identify, starts
+from lugre.diagnosis.inverse import fit_inverse_dynamics
+
+TRUTH = {
+    "axis": {"mass": 12.0, "force_constant": 20.0},
+    "friction": {"model": "lugre", "sigma0": 2.0e5, "sigma1": 150.0,
+                 "positive": {"fc": 9.0, "fs": 16.0, "sigma2": 80.0, "vs": 0.012},
+                 "negative": {"fc": 8.5, "fs": 15.0, "sigma2": 90.0, "vs": 0.010}},
+    "effects": [],
+}
+
+
+def plant(seed: int, seconds: float = 8.0, cogging: float = 0.0) -> lugre.Recording:
+    """A PID-controlled LuGre axis written here (semi-implicit Euler at 5 kHz, its own
+    bristle step), logged at 1 kHz with a 1 um encoder and current noise."""
+    rng = np.random.default_rng(seed)
+    h, n = 2e-4, int(seconds / 2e-4)
+    t = np.arange(n) * h
+    f = rng.uniform(0.2, 0.6, 2)
+    ph = rng.uniform(0, 2 * np.pi, 2)
+    xr = 0.03 * np.sin(2 * np.pi * f[0] * t + ph[0]) + 0.01 * np.sin(2 * np.pi * f[1] * t + ph[1])
+    m, kf = TRUTH["axis"]["mass"], TRUTH["axis"]["force_constant"]
+    fr = TRUTH["friction"]
+    s0, s1 = fr["sigma0"], fr["sigma1"]
+    wn = 2 * np.pi * 15
+    kp, ki, kd = m * wn * wn, m * wn ** 3 / 5, 1.4 * m * wn
+    x = v = z = integ = 0.0
+    x = xr[0]
+    xs, cs = np.empty(n), np.empty(n)
+    for k in range(n):
+        e = xr[k] - x
+        integ += e * h
+        vr = (xr[k] - xr[k - 1]) / h if k else 0.0
+        cur = (kp * e + ki * integ + kd * (vr - v)) / kf
+        xs[k], cs[k] = x, cur
+        st = fr["positive"] if v >= 0 else fr["negative"]
+        g = st["fc"] + (st["fs"] - st["fc"]) * math.exp(-(v / st["vs"]) ** 2)
+        zdot = v - s0 * abs(v) * z / g
+        force = s0 * z + s1 * zdot + st["sigma2"] * v + cogging * math.sin(2 * np.pi * x / 0.01)
+        if v != 0.0:
+            zss = math.copysign(g / s0, v)
+            z = zss + (z - zss) * math.exp(-s0 * abs(v) * h / g)
+        v += h * (kf * cur - force) / m
+        x += h * v
+    sl = slice(0, n, 5)
+    return lugre.Recording(t=t[sl], x=np.round(xs[sl] / 1e-6) * 1e-6,
+                           i=cs[sl] + 0.005 * rng.standard_normal(cs[sl].size))
+
+
+@pytest.fixture(scope="module")
+def records():
+    return plant(1), plant(2)
+
+
+@pytest.fixture(scope="module")
+def fitted(records):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return identify(records[0], force_constant=20.0)
+
+
+def test_fit_reaches_the_truth_on_an_independent_plant(records, fitted):
+    """Mass and friction within 5 % of the plant's, and the held-out force error of the
+    fitted model within 1.3 times the true model's (the linear inverse-dynamics start
+    alone is several times worse)."""
+    rec, hold = records
+    m = fitted.model
+    assert abs(m.mass / 12.0 - 1) < 0.05
+    for d in ("positive", "negative"):
+        for k in ("fc", "fs", "sigma2", "vs"):
+            assert abs(m.friction[d][k] / TRUTH["friction"][d][k] - 1) < 0.05, (d, k)
+            key = f"{d}.hump" if k == "fs" else f"{d}.{k}"
+            assert fitted.profiles[key]["determined"], key
+    true = evaluate(hold, lugre.Model(TRUTH))["nrmse_force"]
+    got = evaluate(hold, m)["nrmse_force"]
+    start = evaluate(hold, fit_inverse_dynamics(rec, force_constant=20.0))["nrmse_force"]
+    assert got <= 1.3 * true
+    assert start > 2 * got
+
+
+def test_intervals_hold_the_truth_where_determined(fitted):
+    truth = lugre.Model(TRUTH)
+    for name, p in fitted.profiles.items():
+        if not p["determined"] or name.startswith("sigma"):
+            continue
+        lo, hi = p["ci95"]
+        side, _, key = name.rpartition(".")
+        want = (truth.mass if name == "mass" else
+                truth.friction[side]["fs"] - truth.friction[side]["fc"] if key == "hump"
+                else truth.friction[side][key])
+        # the intervals carry the noise; a 4 % margin covers the filter's small bias
+        assert lo * 0.96 <= want <= hi * 1.04, (name, lo, want, hi)
+
+
+def test_the_fit_stays_at_the_noise_floor_and_says_so(fitted):
+    words, far = fitted.floor_words()
+    assert not far and fitted.floor_ratio < 1.5
+    assert "noise floor" in words
+
+
+def test_a_left_out_cogging_is_far_from_the_noise_floor():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = identify(plant(3, cogging=1.5), force_constant=20.0, profiles=False)
+    words, far = res.floor_words()
+    assert far and "lugre diagnose" in words
+
+
+def test_no_hump_is_reported_as_such():
+    """A record of an axis without a Stribeck hump: fs = fc within the noise, vs not
+    determined (it does nothing), never a hump invented from a start value."""
+    saved = {d: dict(TRUTH["friction"][d]) for d in ("positive", "negative")}
+    try:
+        for d in ("positive", "negative"):
+            TRUTH["friction"][d]["fs"] = TRUTH["friction"][d]["fc"]
+        rec = plant(4)
+    finally:
+        for d in saved:
+            TRUTH["friction"][d].update(saved[d])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = identify(rec, force_constant=20.0)
+    for d in ("positive", "negative"):
+        hump = res.model.friction[d]["fs"] - res.model.friction[d]["fc"]
+        assert hump < 0.05 * res.model.friction[d]["fc"]
+        assert not res.profiles[f"{d}.vs"]["determined"]
+
+
+def test_core_and_twin_agree(records):
+    """The same fit from the same starts on the core's kernels and on the NumPy twin's."""
+    from lugre import reference
+
+    rec = records[0].slice((0.0, 1.5))
+    start = fit_inverse_dynamics(rec, force_constant=20.0, sliding=0.05)
+    names = base_names(True)
+    out = {}
+    for be in ("core", "reference"):
+        sig = R.prepare(rec, start, backend=be)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            st = starts(start, sig)[:4]
+            out[be] = sig.kernel.fit_base(st, [bool(b) for b in sig.mask], names,
+                                          max_iter=15, keep=2, scouts=3)
+    assert isinstance(R.prepare(rec, start, backend="reference").kernel, reference.InverseRecord)
+    a, b = out["core"], out["reference"]
+    assert a["start"] == b["start"]
+    for k, v in a["values"].items():
+        assert v == pytest.approx(b["values"][k], rel=1e-7, abs=1e-9), k
+    assert a["cost"] == pytest.approx(b["cost"], rel=1e-7)
+
+
+def test_fit_base_refuses_bad_arguments(records):
+    rec = records[0].slice((0.0, 1.0))
+    start = fit_inverse_dynamics(rec, force_constant=20.0)
+    sig = R.prepare(rec, start)
+    mask = [bool(b) for b in sig.mask]
+    with pytest.raises(ValueError, match="names"):
+        sig.kernel.fit_base([start], mask, ["positive.nope"])
+    with pytest.raises(ValueError, match="mask"):
+        sig.kernel.fit_base([start], mask[:-1], ["mass"])
+    with pytest.raises(ValueError, match="start"):
+        sig.kernel.fit_base([], mask, ["mass"])
+    with pytest.raises(ValueError, match="weighting"):
+        sig.kernel.fit_base([start], mask, ["mass"], weighting="bogus")
