@@ -216,3 +216,60 @@ def test_a_small_share_is_not_written_as_zero():
     assert U.percent(0.006) == "1 %"
     assert U.percent(0.0) == "0 %"
     assert U.percent(0.5) == "50 %"
+
+
+WHERES = [
+    None,
+    {},
+    {"position": [-0.1, 0.2], "time": None, "velocity": None},
+    {"velocity": [[-0.05, -0.01], [0.01, 0.04]], "time": [[1.0, 2.0]], "position": []},
+    {"velocity": [[float(k), float(k) + 0.5] for k in range(7)]},
+    {"direction": {"positive": 137.18, "negative": 2.0, "rest": None}, "threshold": 1.2},
+    {"time": [None, 3.0], "velocity": [1, 2, 3], "direction": "forward"},
+]
+
+
+@pytest.mark.parametrize("where", WHERES)
+def test_the_page_takes_every_shape_of_where(where):
+    """Several velocity ranges, a per-direction rest, open ends: the page says where in
+    words and units, never a raw Python structure, and never fails."""
+    report, data = hand_built()
+    report["findings"][0]["where"] = where
+    report["unexplained"]["where"] = where
+    text = _words(diagnosis_page(report, data))
+    assert "{'" not in text and "[[" not in text
+    if isinstance(where, dict) and where.get("direction") and isinstance(where["direction"], dict):
+        assert "moving forward 137 N rms" in text
+
+
+def test_the_page_shows_a_refitted_base():
+    report, data = hand_built()
+    report["rebased"] = {"moves": [{"name": "positive.hump", "given": 0.0, "refit": 31.5,
+                                    "change": 1.1}],
+                         "rms_given": 9.0, "rms_refit": 1.0, "text": "the base was far"}
+    text = _words(diagnosis_page(report, data))
+    assert "Base refitted first" in text and "31.5" in text
+
+
+def _words(page: str) -> str:
+    import html
+
+    return html.unescape(re.sub(r"<[^>]+>", " ", page))
+
+
+def test_fit_page_shows_what_the_record_determines():
+    from lugre.html import fit_page
+
+    doc = lugre.Model.paper().to_dict()
+    doc["identification"] = {
+        "nrmse_force": 0.004, "summary": "force residual 0.1 N rms against a noise floor of "
+        "0.09 N (1.1 times): at the record's noise floor", "far_from_floor": False,
+        "parameters": {"positive.hump": {"value": 31.5, "unit": "N", "ci95": [31.0, 32.0],
+                                         "determined": True, "how": "wald"},
+                       "sigma1": {"value": 3.0, "unit": "N s/m", "ci95": [None, None],
+                                  "determined": False, "how": "profile"}}}
+    text = _words(fit_page(doc, nrmse={"fitted model": 0.004}))
+    assert "What the record determines" in text
+    assert "fs - fc (v >= 0)" in text and "open to open N s/m" in text
+    doc["identification"]["far_from_floor"] = True
+    assert "Check first" in _words(fit_page(doc))
