@@ -7,10 +7,9 @@ from __future__ import annotations
 import math
 import warnings
 
+import lugre
 import numpy as np
 import pytest
-
-import lugre
 from lugre.diagnosis import evaluate
 from lugre.diagnosis import residual as R
 from lugre.diagnosis.basefit import base_names, identify, starts

@@ -10,10 +10,9 @@ import subprocess
 import sys
 import threading
 
+import lugre
 import numpy as np
 import pytest
-
-import lugre
 from lugre._atomic import atomic_write
 
 
