@@ -129,8 +129,8 @@ def test_no_hump_is_reported_as_such():
             TRUTH["friction"][d]["fs"] = TRUTH["friction"][d]["fc"]
         rec = plant(4)
     finally:
-        for d in saved:
-            TRUTH["friction"][d].update(saved[d])
+        for d, st in saved.items():
+            TRUTH["friction"][d].update(st)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = identify(rec, force_constant=20.0)
