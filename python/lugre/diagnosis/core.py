@@ -207,6 +207,10 @@ def _close_rivals(log: list[dict[str, Any]], terms: list[Any],
     return out
 
 
+#: Scale of the base tolerances for a base identified from a record (lugre fit), not
+#: known beforehand: friction levels may move by about a third, not by 3 %.
+IDENTIFY_TOLERANCE = 10.0
+
 #: Rows of a column the held-out scores read at most (longer records: every step-th).
 ROWS_KEPT = 100_000
 
@@ -276,6 +280,14 @@ def diagnose(
     t_start = time.perf_counter()
     model = _as_model(model)  # (warns once if the model given is not passive)
     rec = as_recording(recording)
+    # a base that lugre fit identified (its model file says so) carries whatever the
+    # record's effects put into it: its levels and mass are re-estimated as freely as in
+    # identification, so that an effect the fit absorbed (a dead-band in fc, a spring
+    # in the mass) can be named instead of being held out by the prior
+    fitted = (model.to_dict().get("identification") or {}).get("parameters") or {}
+    if fitted:
+        tolerance = max(tolerance, IDENTIFY_TOLERANCE)
+        free_mass = free_mass or "mass" in fitted
     kw = {"holdout": holdout, "cutoff_hz": cutoff_hz, "blocks": blocks, "alpha": alpha,
           "min_gain": min_gain, "closed_loop": closed_loop, "candidates": candidates,
           "screw_lead": screw_lead, "free_mass": free_mass, "tolerance": tolerance,
@@ -293,6 +305,12 @@ def diagnose(
             dg.model = model
             dg.rebased = {k: v for k, v in far.items() if k != "model"}
             dg.verdict = V.verdict(dg)
+    if fitted:
+        dg.notes.append(
+            "The model's base was identified by lugre fit (its file says so): its friction "
+            "levels" + (" and mass were" if "mass" in fitted else " were") + " re-estimated "
+            "as freely as in identification, so that an effect the fit took into them can "
+            "be named.")
     if model.is_passive and not dg.augmented.is_passive:
         warnings.warn(
             "the augmented model's sigma1 exceeds the passivity bound 4*sigma2*fc/(fs - fc) "

@@ -11,13 +11,10 @@ import numpy as np
 from ..exceptions import DataError
 from ..model import Model
 from . import residual as R
-from .core import as_recording
+from .core import IDENTIFY_TOLERANCE, as_recording
 
 __all__ = ["IDENTIFY_TOLERANCE", "fit_inverse_dynamics", "fit_model"]
 
-#: Scale of the base tolerances when identifying from the rough inverse-dynamics start
-#: (friction levels may move by about a third, not by 3 %).
-IDENTIFY_TOLERANCE = 10.0
 
 
 def fit_inverse_dynamics(
