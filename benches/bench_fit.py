@@ -21,10 +21,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
-from compare import build_c, grid, run_c  # noqa: E402
-
-import lugre  # noqa: E402
-from lugre.diagnosis.basefit import identify  # noqa: E402
+import lugre
+from compare import build_c, grid, run_c
+from lugre.diagnosis.basefit import identify
 
 
 def main() -> None:
