@@ -117,6 +117,16 @@ def fit_inverse_dynamics(recording: Any, *args: Any, **kwargs: Any) -> Any:
     return _fit(_table_or_same(recording), *args, **kwargs)
 
 
+def fit_model(recording: Any, **kwargs: Any) -> Any:
+    """Identify an axis model from a recording: ``(model, fit)``, the fit with every
+    parameter's interval, what the record leaves open and how far the fit is from the
+    record's noise floor; ``recording`` may be a table with named columns. See
+    :func:`lugre.diagnosis.fit_model`."""
+    from .diagnosis import fit_model as _fit
+
+    return _fit(_table_or_same(recording), **kwargs)
+
+
 def fit_dynamic(recording: Any, *args: Any, **kwargs: Any) -> Any:
     """sigma0 and sigma1 from a closed-loop record; ``recording`` may be a table with
     named columns. See :func:`lugre.identify.fit_dynamic`."""
@@ -159,6 +169,7 @@ __all__ = [
     "evaluate",
     "fit_dynamic",
     "fit_inverse_dynamics",
+    "fit_model",
     "fit_static",
     "friction_force",
     "load_coupling",

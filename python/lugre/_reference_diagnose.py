@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["diagnose", "fit_inverse_dynamics"]
+__all__ = ["diagnose", "fit_inverse_dynamics", "fit_model"]
 
 
 def diagnose(recording: Any, model: Any, **kwargs: Any) -> Any:
@@ -58,3 +58,25 @@ def fit_inverse_dynamics(recording: Any, *args: Any, **kwargs: Any) -> Any:
 
     kwargs["backend"] = "reference"
     return _fit(recording, *args, **kwargs)
+
+
+def fit_model(recording: Any, **kwargs: Any) -> Any:
+    """Twin of :func:`lugre.fit_model` on the NumPy kernels (the base fit of
+    ``lugre._reference_basefit``; slow: for checking on short records).
+
+    Parameters
+    ----------
+    recording : Recording, path or table with named columns
+        With motion in both directions.
+    **kwargs
+        As :func:`lugre.diagnosis.fit_model` (``backend`` fixed to ``"reference"``).
+
+    Returns
+    -------
+    tuple
+        ``(model, fit)``.
+    """
+    from . import fit_model as _fit
+
+    kwargs["backend"] = "reference"
+    return _fit(recording, **kwargs)

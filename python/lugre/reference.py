@@ -74,6 +74,7 @@ __all__ = [
     "evaluate",
     "fit_dynamic",
     "fit_inverse_dynamics",
+    "fit_model",
     "fit_static",
     "friction_force",
     "load_coupling",
@@ -96,6 +97,7 @@ _LAZY = {
     "evaluate": "._reference_evaluate",
     "diagnose": "._reference_diagnose",
     "fit_inverse_dynamics": "._reference_diagnose",
+    "fit_model": "._reference_diagnose",
     "steady_state_points": "._reference_plateaus",
     # the periodogram of the diagnosis (twin of lugre._native.position_sums)
     "position_sums": "._reference_inverse",
