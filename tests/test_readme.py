@@ -20,6 +20,6 @@ def test_readme_python_example_runs(code, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        exec(compile(code, str(README), "exec"), {"__name__": "readme"})
+        exec(compile(code, str(README), "exec"), {"__name__": "readme"})  # noqa: S102
     if "rec.csv" in code:
         assert (tmp_path / "rec.csv").is_file()

@@ -58,7 +58,7 @@ from .model import (
 )
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ._reference_diagnose import diagnose, fit_inverse_dynamics
+    from ._reference_diagnose import diagnose, fit_inverse_dynamics, fit_model
     from ._reference_dynamic import DynamicFit, fit_dynamic
     from ._reference_evaluate import evaluate
     from ._reference_plateaus import steady_state_points
