@@ -1,8 +1,8 @@
 """Test-wide rules.
 
-In CI (``CI`` set, as ``.ci/run`` does) a test that would skip because the shared
-datasets (``../shared``) or the headless browser are missing FAILS instead: CI must run
-every check, and a silent skip would hide a broken setup.
+In CI (``CI`` set, as ``.ci/run`` does) a test that would skip because its data or the
+headless browser are missing FAILS instead: CI must run every check, and a silent skip
+would hide a broken setup. (The data the tests read is in the repository, tests/data.)
 """
 
 from __future__ import annotations

@@ -1,18 +1,17 @@
-//! Static (Stribeck) identification on the shared paper-axis data sets.
+//! Static (Stribeck) identification on the paper-axis data sets (tests/data, written by a
+//! plant independent of this crate; see tests/data/README.md).
 
 use lugre::estimate::{fit_static, plateaus_from_recording, PlateauOptions, StaticFitOptions};
 use std::path::PathBuf;
 
+/// A file of the project's test data: it is part of the repository, so a missing one
+/// fails the test rather than skipping it.
 fn dataset(rel: &str) -> Option<PathBuf> {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/datasets")
+        .join("tests/data/datasets")
         .join(rel);
-    if p.exists() {
-        Some(p)
-    } else {
-        eprintln!("skipped: {} not found", p.display());
-        None
-    }
+    assert!(p.exists(), "test data {} is missing", p.display());
+    Some(p)
 }
 
 fn read_csv(p: &PathBuf) -> Vec<Vec<f64>> {

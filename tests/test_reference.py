@@ -37,7 +37,7 @@ from lugre.exceptions import (
 )
 from lugre.io import Recording, read_recording, write_recording
 from lugre.model import Model, _as_model, load_model, save_model
-from shared_data import SHARED  # ../shared: data the project did not write
+from shared_data import shared_file  # tests/data: data the project did not write
 
 settings.register_profile("fast", max_examples=30, deadline=None)
 settings.register_profile("slow", max_examples=500, deadline=None)
@@ -45,11 +45,8 @@ settings.load_profile(os.environ.get("LUGRE_HYPOTHESIS_PROFILE", "fast"))
 
 
 def shared(*parts: str) -> Path:
-    """A file under ``../shared/datasets``; skips the test when it is absent."""
-    p = SHARED.joinpath("datasets", *parts)
-    if not p.exists():
-        pytest.skip(f"shared dataset {p} is absent (expected ../shared next to the repo)")
-    return p
+    """A file of the test data (tests/data/datasets)."""
+    return shared_file(*parts)
 
 
 def model_from_truth(path: Path) -> Model:
