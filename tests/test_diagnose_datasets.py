@@ -26,6 +26,9 @@ def test_mismatch_case(case):
                   holdout=lugre.read_recording(d / "holdout.csv"), closed_loop=False)
     named = [f.effect for f in dg.findings]
     assert named == [e["effect"] for e in truth]
+    from lugre.html import diagnosis_page
+
+    assert "Verdict" in diagnosis_page(dg.to_dict(), dg.data)  # the page of every report
     before = dg.fit["holdout_before"]["rms_force"]
     after = dg.fit["holdout_after"]["rms_force"]
     if truth:
