@@ -179,9 +179,10 @@ class _Problem:
                 break
             lam = max(lam / 3.0, 1e-9)
             rel = (cost - accepted[3]) / max(cost, 1e-300)
+            moved = float(np.max(np.abs(accepted[1] - u))) if u.size else 0.0
             doc, u, r = accepted[0], accepted[1], accepted[2]
             w, scale = self.weights(r)
-            small = small + 1 if rel < tol else 0
+            small = small + 1 if (rel < tol or moved < 1e-5) else 0
             if small >= 2:
                 break
         return {"doc": doc, "r": r, "w": w, "scale": scale, "iterations": iterations,
@@ -190,7 +191,7 @@ class _Problem:
 
 def fit_base(rec: Any, starts: list[Any], mask: Any, names: list[str], max_iter: int = 60,
              keep: int = 3, scouts: int = 12, weighting: str = "huber",
-             scout_iter: int = 6, tol: float = 1e-7) -> dict[str, Any]:
+             scout_iter: int = 6, tol: float = 1e-6) -> dict[str, Any]:
     """Twin of ``_core.InverseRecord.fit_base`` (see ``lugre::inverse::fit_base``)."""
     mask = np.asarray(mask, dtype=bool)
     if mask.size != len(rec):

@@ -124,7 +124,8 @@ pub struct BaseFitOptions {
     pub scout_iter: usize,
     /// Starts then followed to convergence (the best scouts).
     pub keep: usize,
-    /// Relative decrease of the weighted sum of squares below which a start stops.
+    /// Relative decrease of the weighted sum of squares below which a start stops (as
+    /// it does when no parameter moves by 1e-5 of its scale), twice in a row.
     pub tol: f64,
     /// Weights of the residuals (Huber by default: a structured misfit such as the
     /// sticking phases is down-weighted, never rejected).
@@ -138,7 +139,7 @@ impl Default for BaseFitOptions {
             scouts: 12,
             scout_iter: 6,
             keep: 3,
-            tol: 1e-7,
+            tol: 1e-6,
             weighting: Weighting::huber(),
         }
     }
@@ -402,11 +403,21 @@ impl Problem<'_> {
             };
             lam = (lam / 3.0).max(1e-9);
             let rel = (cost - c2) / cost.max(1e-300);
+            let moved = u2
+                .iter()
+                .zip(&u)
+                .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
             model = m2;
             u = u2;
             r = r2;
             (w, scale) = self.weights(&r);
-            small = if rel < self.opts.tol { small + 1 } else { 0 };
+            // converged: the sum of squares or the parameters (1e-5 of a log unit or of
+            // a linear scale) stop moving, twice in a row
+            small = if rel < self.opts.tol || moved < 1e-5 {
+                small + 1
+            } else {
+                0
+            };
             if small >= 2 {
                 break;
             }

@@ -18,7 +18,8 @@ from ..model import Model
 from . import residual as R
 from .base import apply_base, get_base
 
-__all__ = ["BaseFitResult", "base_names", "fit_base", "identify", "profile_all", "starts"]
+__all__ = ["BaseFitResult", "base_names", "fit_base", "identify", "profile_all", "starts",
+           "with_profiles"]
 
 #: A profile that rises by less than this (chi-square, one parameter, 95 %) over a
 #: factor of ten either way leaves the parameter not determined on that side.
@@ -33,7 +34,7 @@ SLIDING = 0.05
 
 #: Starts: hump ratios fs/fc, Stribeck speeds (shares of the largest speed) and
 #: presliding displacements fs/sigma0 (shares of the stroke, at least a few counts).
-RATIOS = (1.0, 1.5, 2.2, 3.2)
+RATIOS = (1.0, 1.6, 2.6)
 #: ... and shares of the linear fit's Coulomb level (the rest of the mean sliding
 #: friction given to the viscous term): the linear fit trades one for the other.
 FC_SHARES = (1.0, 0.6, 0.35)
@@ -49,7 +50,7 @@ MIN_HALF = 1000
 BAND_CHANGE = 1.25
 
 #: Starts followed a few iterations before the best few are followed to the end.
-SCOUTS = 24
+SCOUTS = 16
 VS_SHARES = (0.003, 0.01, 0.03, 0.1, 0.3)
 
 
@@ -71,6 +72,8 @@ class BaseFitResult:
     evaluations: int
     profiles: dict[str, dict[str, Any]] = field(default_factory=dict)
     diagnosis: Any = None
+    #: ``J^T W J`` of the fit in the parameters themselves (for the intervals)
+    information: Any = field(default=None, repr=False)
 
     @property
     def floor_ratio(self) -> float:
@@ -198,11 +201,17 @@ def fit_base(sig: R.Signals, model: Model, *, free_mass: bool, extra: list[Model
     used = r[sig.mask]
     res = BaseFitResult(model=best, names=tuple(names), scale=float(out["scale"]),
                         rms=float(np.sqrt(np.mean(used * used))), noise=float(nf["rms"]),
-                        n_eff=float(nf["n_eff"]), evaluations=int(out["evaluations"]))
-    if profiles:
-        res = replace(res, profiles=profile_all(sig, res, out["information"], shift))
-        res = simplest(sig, res)
-    return res
+                        n_eff=float(nf["n_eff"]), evaluations=int(out["evaluations"]),
+                        information=np.asarray(out["information"]))
+    return with_profiles(sig, res, shift) if profiles else res
+
+
+def with_profiles(sig: R.Signals, res: BaseFitResult,
+                  shift: dict[str, float] | None = None) -> BaseFitResult:
+    """``res`` with every parameter's interval and determinacy, and the simplest values
+    where the record is silent (:func:`simplest`)."""
+    res = replace(res, profiles=profile_all(sig, res, res.information, shift))
+    return simplest(sig, res)
 
 
 def simplest(sig: R.Signals, res: BaseFitResult) -> BaseFitResult:
@@ -410,8 +419,7 @@ def _identify(rec: Any, mass: float | None, force_constant: float, cutoff_hz: fl
         return res
     shift = sampling_shift(rec, res, cutoff_hz=cutoff_hz, backend=backend,
                            free_mass=mass is None)
-    return fit_base(sig, res.model, free_mass=mass is None, profiles=True, grid=False,
-                    shift=shift)
+    return with_profiles(sig, res, shift)
 
 
 def sampling_shift(rec: Any, res: BaseFitResult, *, cutoff_hz: float | None, backend: str,
