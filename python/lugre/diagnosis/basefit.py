@@ -216,16 +216,18 @@ def with_profiles(sig: R.Signals, res: BaseFitResult,
 
 def simplest(sig: R.Signals, res: BaseFitResult) -> BaseFitResult:
     """Where the record leaves a parameter open, the simplest value it allows: a hump
-    that the noise allows down to zero is zero (fs = fc; a break-away of ten times the
-    Coulomb level on a handful of samples is no finding), and a damping sigma1 it does
-    not determine is held within the passivity bound. The others are refitted."""
+    that the noise allows from zero to any size is zero (fs = fc; a break-away of ten
+    times the Coulomb level on a handful of samples is no finding; a hump bounded above
+    is kept, as the record put it), and a damping sigma1 it does not determine is held
+    within the passivity bound. The others are refitted."""
     prof = dict(res.profiles)
     vals: dict[str, float] = {}
     held: list[str] = []
     for d in SIDES:
         p = prof.get(f"{d}.hump")
-        if p and not p["determined"] and p["value"] > 0 and (p.get("ci95") or [None])[0] in (
-                None, 0.0):
+        ci = (p or {}).get("ci95") or [None, None]
+        if p and not p["determined"] and p["value"] > 0 and ci[0] in (None, 0.0) and (
+                ci[1] is None):
             vals[f"{d}.fs"] = get_base(res.model, f"{d}.fc")
             held += [f"{d}.hump", f"{d}.vs"]
     s1 = prof.get("sigma1")
