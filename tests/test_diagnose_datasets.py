@@ -194,3 +194,31 @@ def test_a_resonance_in_the_model_is_searched_again(frequency, load, replaced):
     (f,) = dg.findings
     assert f.parameters["frequency"] == pytest.approx(22.0, rel=0.1)
     assert f.parameters["load_fraction"] == pytest.approx(0.75, abs=0.1)
+
+
+def test_a_far_base_is_refitted_before_anything_is_named():
+    """The clean public record against its model with the Stribeck hump removed, vs six
+    times too large and sigma0 twenty times too small: the base is refitted first (to
+    the record's hump, vs and sigma0), nothing is named in its place, and the report
+    gives the model as given's held-out error beside the refitted one's."""
+    d = MISMATCH / "none"
+    m = lugre.load_model(d / "model.json").to_dict()
+    for s in ("positive", "negative"):
+        m["friction"][s]["fs"] = m["friction"][s]["fc"]
+        m["friction"][s]["vs"] *= 6
+    m["friction"]["sigma0"] *= 0.05
+    dg = diagnose(lugre.read_recording(d / "recording.csv"), m,
+                  holdout=lugre.read_recording(d / "holdout.csv"), closed_loop=False)
+    assert dg.findings == []
+    assert dg.rebased is not None
+    moved = {mv["name"] for mv in dg.rebased["moves"]}
+    assert {"positive.hump", "negative.hump", "sigma0"} <= moved
+    aug = dg.augmented_model()
+    for s in ("positive", "negative"):
+        assert aug.friction[s]["fs"] - aug.friction[s]["fc"] == pytest.approx(31.5, rel=0.1)
+        assert aug.friction[s]["vs"] == pytest.approx(0.01, rel=0.1)
+    assert dg.rebased["holdout_given"]["rms_force"] > 20 * dg.fit["holdout_after"]["rms_force"]
+    assert dg.verdict.startswith("The base as given is far")
+    from lugre.html import diagnosis_page
+
+    assert "Base refitted first" in diagnosis_page(dg.to_dict(), dg.data)

@@ -304,6 +304,14 @@ def diagnose(
             dg = _diagnose(rec, far["model"], **kw)
             dg.model = model
             dg.rebased = {k: v for k, v in far.items() if k != "model"}
+            # the model as given, on this record and the held-out one (the fit's
+            # "before" is the refitted base's)
+            dg.rebased["given"] = {k: v for k, v in evaluate(rec, model).items()
+                                   if k in ("rms_force", "nrmse_force")}
+            if holdout is not None:
+                dg.rebased["holdout_given"] = {
+                    k: v for k, v in evaluate(as_recording(holdout), model).items()
+                    if k in ("rms_force", "nrmse_force")}
             dg.verdict = V.verdict(dg)
     if fitted:
         dg.notes.append(

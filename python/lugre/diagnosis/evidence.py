@@ -832,6 +832,10 @@ def verdict(dg: Any) -> str:
     gone = getattr(dg, "removed", [])
     rebased = getattr(dg, "rebased", None)
     head = (rebased["text"][0].upper() + rebased["text"][1:] + ". ") if rebased else ""
+    if rebased and rebased.get("holdout_given") and ha:
+        head += (f"On the held-out record the model as given misses by "
+                 f"{rebased['holdout_given']['rms_force']:.3g} N rms, the refitted base with "
+                 f"what is found below by {ha['rms_force']:.3g} N. ")
     if not gone:
         return head + _verdict_findings(dg, gain)
     # the model's own effects that the record contradicts come first: they are what the
