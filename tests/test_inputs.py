@@ -70,6 +70,21 @@ def test_fit_static_plot_onto_the_input_is_refused(tmp_path):
     assert not (tmp_path / "m.json").exists()
 
 
+def test_a_figure_never_overwrites_an_input(case, tmp_path):
+    """A model named like one of the figures, in the --plots directory: refused before
+    anything is written, the model untouched."""
+    d, _, believed = case
+    model = tmp_path / "overlay.png"
+    lugre.save_model(believed, model)
+    before = model.read_bytes()
+    r = run("diagnose", d / "rec.csv", "--model", model, "--json", tmp_path / "r.json",
+            "--plots", tmp_path)
+    line = one_line_error(r)
+    assert r.returncode == 2 and "--plots" in line and "overlay.png" in line
+    assert model.read_bytes() == before
+    assert not (tmp_path / "r.json").exists()
+
+
 def test_plots_onto_an_existing_file_is_refused_before_anything_is_written(case, tmp_path):
     d, _, _ = case
     (tmp_path / "figs").write_text("not a directory")

@@ -293,11 +293,17 @@ def _cmd_diagnose(args: argparse.Namespace) -> int:
     from .diagnosis import diagnose, write_plots
     from .model import load_model, save_model
 
+    from .diagnosis.plots import PLOT_FILES
+
     plots = args.plots or str(Path(args.json).with_suffix("")) + "_plots"
-    _check_outputs({"RECORDING": args.recording, "--model": args.model,
-                    "--holdout": args.holdout},
-                   {"--json": args.json, "--out-model": args.out_model, "--html": args.html},
-                   {"--plots": plots})
+    inputs = {"RECORDING": args.recording, "--model": args.model, "--holdout": args.holdout}
+    outputs = {"--json": args.json, "--out-model": args.out_model, "--html": args.html}
+    _check_outputs(inputs, outputs, {"--plots": plots})
+    for name in PLOT_FILES:  # the figures' own files: never an input or another output
+        for opt, path in {**inputs, **outputs}.items():
+            if path and _same(os.path.join(plots, name), path):
+                raise UsageError.option("--plots", f"{plots} would overwrite {path} ({opt}) "
+                                        f"with its figure {name}: choose another directory")
     pr = _progress(args)
     model = load_model(args.model)
     rec = _read(args, args.recording)

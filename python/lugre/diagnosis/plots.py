@@ -9,7 +9,11 @@ import numpy as np
 
 from .report import Diagnosis
 
-__all__ = ["write_plots"]
+__all__ = ["PLOT_FILES", "write_plots"]
+
+#: The files :func:`write_plots` writes into its directory.
+PLOT_FILES = ("residual_time.png", "residual_position.png", "residual_velocity.png",
+              "residual_spectrum.png", "overlay.png")
 
 
 def write_plots(diagnosis: Diagnosis, out_dir: str | os.PathLike[str]) -> list[Path]:
@@ -50,10 +54,17 @@ def write_plots(diagnosis: Diagnosis, out_dir: str | os.PathLike[str]) -> list[P
     files: list[Path] = []
 
     def save(fig: plt.Figure, name: str) -> None:
+        # whole or nothing, like every other output (a device or FIFO written through)
+        import io
+
+        from .._atomic import atomic_write
+
         p = out / name
         fig.tight_layout()
-        fig.savefig(p, dpi=110)
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=110)
         plt.close(fig)
+        atomic_write(p, buf.getvalue())
         files.append(p)
 
     # one unit per quantity across the figures: position in mm, speed in mm/s
