@@ -291,9 +291,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 def _cmd_diagnose(args: argparse.Namespace) -> int:
     from .diagnosis import diagnose, write_plots
-    from .model import load_model, save_model
-
     from .diagnosis.plots import PLOT_FILES
+    from .model import load_model, save_model
 
     plots = args.plots or str(Path(args.json).with_suffix("")) + "_plots"
     inputs = {"RECORDING": args.recording, "--model": args.model, "--holdout": args.holdout}
