@@ -79,10 +79,17 @@ def pages(tmp_path_factory):
     dg = diagnose(rec, believed, closed_loop=False)
     (d / "diagnosis.html").write_text(diagnosis_page(dg.to_dict(), dg.data))
     (d / "paper.html").write_text(paper_page(paper_doc()))
+    from lugre import fit_model
+    from lugre.diagnosis.fitreport import identification
+    from lugre.html import fit_page
+
+    model, fit = fit_model(rec, force_constant=believed.force_constant)
+    doc = model.replace(identification=identification(fit, model, 0.01)).to_dict()
+    (d / "fit.html").write_text(fit_page(doc, rec, nrmse={"fitted model": 0.01}))
     return d
 
 
-@pytest.mark.parametrize("name", ["hand_built", "diagnosis", "paper"])
+@pytest.mark.parametrize("name", ["hand_built", "diagnosis", "paper", "fit"])
 @pytest.mark.parametrize("width", [1000, 390])  # a laptop and a phone
 def test_page_renders_and_fetches_nothing(pages, name, width, tmp_path):
     page = pages / f"{name}.html"
