@@ -176,3 +176,23 @@ def test_fit_base_refuses_bad_arguments(records):
         sig.kernel.fit_base([], mask, ["mass"])
     with pytest.raises(ValueError, match="weighting"):
         sig.kernel.fit_base([start], mask, ["mass"], weighting="bogus")
+
+
+def test_fit_with_effects_refits_the_base_with_them():
+    """The public cogging case (an independent plant): without the cogging in the model
+    the hump is pulled astray by it; `fit --effects cogging` finds the cogging and fits
+    the base again with it held, to the plant's levels."""
+    from lugre import fit_model
+    from shared_data import shared_file
+
+    rec = lugre.read_recording(shared_file("mismatch", "cogging", "recording.csv"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model, fit = fit_model(rec, force_constant=25.0, effects=["cogging"])
+    cog = next(e for e in model.effects if e["effect"] == "cogging")
+    assert cog["amplitude"] == pytest.approx(3.0, rel=0.05)
+    assert cog["pitch"] == pytest.approx(0.025, rel=0.01)
+    for d, fs in (("positive", 60.2), ("negative", 60.1)):
+        assert model.friction[d]["fs"] == pytest.approx(fs, rel=0.05)
+        assert model.friction[d]["vs"] == pytest.approx(0.01, rel=0.1)
+    assert not fit.floor_words()[1]  # at the noise floor once the cogging is in
