@@ -12,8 +12,9 @@ import lugre
 import numpy as np
 import pytest
 from scipy import integrate, signal
+from shared_data import SHARED
 
-DATASETS = Path(__file__).resolve().parents[2] / "shared" / "datasets" / "mismatch"
+DATASETS = SHARED / "datasets" / "mismatch"  # tests/data (see its README)
 
 
 def axis(effects, *, friction=None, controller=True):
@@ -171,7 +172,6 @@ DATASET_GAIN = {
 }
 
 
-@pytest.mark.skipif(not DATASETS.is_dir(), reason="shared datasets not available")
 @pytest.mark.parametrize("name", sorted(DATASET_GAIN))
 @pytest.mark.parametrize("which", ["recording.csv", "holdout.csv"])
 def test_datasets_current_agrees(name, which):
