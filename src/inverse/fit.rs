@@ -36,7 +36,8 @@ pub enum FitParam {
 }
 
 impl FitParam {
-    /// Parse `mass`, `sigma0`, `sigma1` or `positive|negative.fc|hump|sigma2|vs`.
+    /// Parse `mass`, `sigma0`, `sigma1` or `positive|negative.fc|hump|sigma2|vs` (the
+    /// paths of [`BaseParam::parse`], with `hump` for `fs - fc` and without `fs`).
     pub fn parse(name: &str) -> Result<FitParam> {
         let bad = || {
             Error::input(
@@ -47,24 +48,41 @@ impl FitParam {
                 ),
             )
         };
-        match name {
-            "mass" => return Ok(FitParam::Mass),
-            "sigma0" => return Ok(FitParam::Sigma0),
-            "sigma1" => return Ok(FitParam::Sigma1),
-            _ => {}
+        if name == "mass" {
+            return Ok(FitParam::Mass);
         }
-        let (s, k) = name.split_once('.').ok_or_else(bad)?;
-        let pos = match s {
-            "positive" => true,
-            "negative" => false,
-            _ => return Err(bad()),
-        };
-        match k {
-            "fc" => Ok(FitParam::Fc(pos)),
-            "hump" => Ok(FitParam::Hump(pos)),
-            "sigma2" => Ok(FitParam::Sigma2(pos)),
-            "vs" => Ok(FitParam::Vs(pos)),
-            _ => Err(bad()),
+        if let Some(side) = name.strip_suffix(".hump") {
+            return match BaseParam::parse(&format!("{side}.fc")) {
+                Ok(BaseParam::Fc(p)) => Ok(FitParam::Hump(p)),
+                _ => Err(bad()),
+            };
+        }
+        match BaseParam::parse(name).map_err(|_| bad())? {
+            BaseParam::Fc(p) => Ok(FitParam::Fc(p)),
+            BaseParam::Sigma2(p) => Ok(FitParam::Sigma2(p)),
+            BaseParam::Vs(p) => Ok(FitParam::Vs(p)),
+            BaseParam::Sigma0 => Ok(FitParam::Sigma0),
+            BaseParam::Sigma1 => Ok(FitParam::Sigma1),
+            BaseParam::Fs(_) => Err(bad()),
+        }
+    }
+
+    /// The sensitivity columns whose sum is its column (none for the mass: the
+    /// acceleration); `fc` moves `fs` with it.
+    fn columns(self) -> &'static [BaseParam] {
+        use BaseParam as B;
+        match self {
+            FitParam::Mass => &[],
+            FitParam::Fc(true) => &[B::Fc(true), B::Fs(true)],
+            FitParam::Fc(false) => &[B::Fc(false), B::Fs(false)],
+            FitParam::Hump(true) => &[B::Fs(true)],
+            FitParam::Hump(false) => &[B::Fs(false)],
+            FitParam::Sigma2(true) => &[B::Sigma2(true)],
+            FitParam::Sigma2(false) => &[B::Sigma2(false)],
+            FitParam::Vs(true) => &[B::Vs(true)],
+            FitParam::Vs(false) => &[B::Vs(false)],
+            FitParam::Sigma0 => &[B::Sigma0],
+            FitParam::Sigma1 => &[B::Sigma1],
         }
     }
 
@@ -296,42 +314,29 @@ impl Problem<'_> {
 
     /// Columns `d (model force)/d u`, at the masked samples.
     fn jacobian(&self, m: &Model, u: &[f64]) -> Vec<Vec<f64>> {
-        let base: Vec<BaseParam> = vec![
-            BaseParam::Fc(true),
-            BaseParam::Fs(true),
-            BaseParam::Sigma2(true),
-            BaseParam::Vs(true),
-            BaseParam::Fc(false),
-            BaseParam::Fs(false),
-            BaseParam::Sigma2(false),
-            BaseParam::Vs(false),
-            BaseParam::Sigma0,
-            BaseParam::Sigma1,
-        ];
+        // only the sensitivities the fitted parameters need, each once
+        let mut base: Vec<BaseParam> = Vec::new();
+        for b in self.params.iter().flat_map(|p| p.columns()) {
+            if !base.contains(b) {
+                base.push(*b);
+            }
+        }
         let sens = self.rec.base_sensitivities(m, &base);
-        let col = |b: BaseParam| &sens.columns[base.iter().position(|x| *x == b).unwrap()];
-        let side = |p: bool| if p { 0 } else { 4 };
+        let col = |b: &BaseParam| &sens.columns[base.iter().position(|x| x == b).unwrap()];
         let mut out = Vec::with_capacity(self.params.len());
         for ((p, sc), &ui) in self.params.iter().zip(&self.scales).zip(u) {
             let d = self.slope(*sc, ui);
-            let c: Vec<f64> = match *p {
-                FitParam::Mass => self.rec.a.clone(),
-                FitParam::Fc(s) => {
-                    let (a, b) = (&sens.columns[side(s)], &sens.columns[side(s) + 1]);
-                    a.iter().zip(b).map(|(x, y)| x + y).collect()
-                }
-                FitParam::Hump(s) => col(BaseParam::Fs(s)).clone(),
-                FitParam::Sigma2(s) => col(BaseParam::Sigma2(s)).clone(),
-                FitParam::Vs(s) => col(BaseParam::Vs(s)).clone(),
-                FitParam::Sigma0 => col(BaseParam::Sigma0).clone(),
-                FitParam::Sigma1 => col(BaseParam::Sigma1).clone(),
+            let mut c = match p.columns() {
+                [] => self.rec.a.clone(),
+                [first, rest @ ..] => rest.iter().fold(col(first).clone(), |mut acc, b| {
+                    acc.iter_mut().zip(col(b)).for_each(|(a, x)| *a += x);
+                    acc
+                }),
             };
-            out.push(
-                c.iter()
-                    .zip(self.mask)
-                    .map(|(x, &k)| if k { x * d } else { 0.0 })
-                    .collect(),
-            );
+            for (x, &k) in c.iter_mut().zip(self.mask) {
+                *x = if k { *x * d } else { 0.0 };
+            }
+            out.push(c);
         }
         out
     }

@@ -107,8 +107,9 @@ def base_names(free_mass: bool) -> list[str]:
 
 
 def starts(model: Model, sig: R.Signals) -> list[Model]:
-    """Start models around ``model`` (its levels and mass kept): every hump ratio,
-    Stribeck speed and presliding displacement of the grids, the model itself first."""
+    """Start models around ``model`` (its mass and effects kept): the model itself
+    first, then every hump ratio, Stribeck speed, presliding displacement and
+    Coulomb/viscous split of the grids."""
     vmax = float(np.max(np.abs(sig.v[sig.mask]))) or 1e-6
     xs = sig.x[sig.mask]
     stroke = float(np.ptp(xs)) or 1e-6
@@ -136,15 +137,11 @@ def starts(model: Model, sig: R.Signals) -> list[Model]:
     return out
 
 
-def _model_of(model: Model, values: dict[str, float]) -> Model:
-    return apply_base(model, {k: v for k, v in values.items()})
-
-
 def _run(sig: R.Signals, start: list[Model], names: list[str], keep: int = 3,
          max_iter: int = 60) -> tuple[Model, dict[str, Any]]:
     out = sig.kernel.fit_base(start, [bool(b) for b in sig.mask], names,
                               max_iter=max_iter, keep=keep, scouts=max(keep, SCOUTS))
-    return _model_of(start[out["start"]], out["values"]), out
+    return apply_base(start[out["start"]], out["values"]), out
 
 
 def _value(model: Model, name: str) -> float:
@@ -414,8 +411,7 @@ def _identify(rec: Any, mass: float | None, force_constant: float, cutoff_hz: fl
     # the band of the fitted model, from the grid around it
     sig2 = R.prepare(rec, res.model, cutoff_hz=cutoff_hz, backend=backend)
     if abs(math.log(sig2.cutoff_hz / sig.cutoff_hz)) > math.log(BAND_CHANGE):
-        res = fit_base(sig2, res.model, free_mass=mass is None, profiles=False,
-                       extra=[res.model])
+        res = fit_base(sig2, res.model, free_mass=mass is None, profiles=False)
         sig = sig2
     if not profiles:
         return res

@@ -7,12 +7,11 @@ import math
 from typing import Any
 
 from ..model import Model
+from .base import unit
 from .basefit import BaseFitResult
 
-__all__ = ["identification", "label", "undetermined_notes"]
+__all__ = ["fit_unit", "identification", "label", "undetermined_notes"]
 
-_UNITS = {"mass": "kg", "fc": "N", "hump": "N", "sigma2": "N s/m", "vs": "m/s",
-          "sigma0": "N/m", "sigma1": "N s/m"}
 
 #: What would determine a parameter the record leaves open.
 _WOULD = {
@@ -34,6 +33,11 @@ def _key(name: str) -> str:
     return name.split(".")[-1]
 
 
+def fit_unit(name: str) -> str:
+    """SI unit of a fitted parameter (``positive.hump`` is in the unit of ``fs``)."""
+    return unit(name.replace(".hump", ".fs"))
+
+
 def label(name: str) -> str:
     """``positive.hump`` -> ``fs - fc (v >= 0)``."""
     side, _, key = name.rpartition(".")
@@ -51,7 +55,7 @@ def identification(fit: BaseFitResult, model: Model, nrmse: float) -> dict[str, 
     params = {}
     for name, p in fit.profiles.items():
         ci = p.get("ci95") or [None, None]
-        params[name] = {"value": float(p["value"]), "unit": _UNITS[_key(name)],
+        params[name] = {"value": float(p["value"]), "unit": fit_unit(name),
                         "ci95": [_num(ci[0]), _num(ci[1])],
                         "determined": bool(p["determined"]), "how": p["how"]}
     words, far = fit.floor_words()
@@ -67,7 +71,7 @@ def undetermined_notes(fit: BaseFitResult) -> list[str]:
         if p["determined"]:
             continue
         key = _key(name)
-        val = f"{p['value']:.4g} {_UNITS[key]}"
+        val = f"{p['value']:.4g} {fit_unit(name)}"
         if p["how"] == "held (simplest)":
             what = ("set to zero (fs = fc)" if key == "hump" else "held within the passivity "
                     "bound" if key == "sigma1" else "held: without a hump it does nothing")

@@ -221,5 +221,5 @@ def fit_model(
     sig = R.prepare(rec, model, cutoff_hz=cutoff_hz, backend=backend)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        final = fit_base(sig, model, free_mass=mass is None, extra=[model])
+        final = fit_base(sig, model, free_mass=mass is None)  # (model: the first start)
     return final.model, replace(final, diagnosis=dg)

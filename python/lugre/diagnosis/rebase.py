@@ -12,7 +12,7 @@ import numpy as np
 
 from ..model import Model
 from . import residual as R
-from .base import BASE_PARAMS, apply_base
+from .base import BASE_PARAMS, apply_base, get_base
 from .basefit import _run, _value, base_names, fit_base
 
 __all__ = ["REBASE_GAIN", "REBASE_TOLERANCES", "far_base"]
@@ -57,7 +57,7 @@ def far_base(rec: Any, given: Model, augmented: Model, *, cutoff_hz: float | Non
     # effects pull it astray: a cogging on the slow samples doubles a hump), then put
     # into the given model, whose search runs again
     full = fit_base(sig, augmented, free_mass=free_mass, extra=[quick], profiles=False)
-    refit = apply_base(given, _base_values(full.model))
+    refit = apply_base(given, {n: get_base(full.model, n) for n, _ in BASE_PARAMS})
     moves = _moves(given, refit, names) or moved
     text = ("the base as given is far from what this record supports: "
             + ", ".join(_move_words(m) for m in moves)
@@ -66,14 +66,6 @@ def far_base(rec: Any, given: Model, augmented: Model, *, cutoff_hz: float | Non
             "that no finding stands in for a base parameter")
     return {"model": refit, "moves": moves, "rms_given": rms0, "rms_refit": rms1,
             "text": text}
-
-
-def _base_values(m: Model) -> dict[str, float]:
-    out = {"mass": float(m.mass), "sigma0": float(m.sigma0), "sigma1": float(m.sigma1)}
-    for d in ("positive", "negative"):
-        for k in ("fc", "fs", "sigma2", "vs"):
-            out[f"{d}.{k}"] = float(m.friction[d][k])
-    return out
 
 
 def _moves(given: Model, refit: Model, names: list[str]) -> list[dict[str, Any]]:
@@ -90,12 +82,7 @@ def _moves(given: Model, refit: Model, names: list[str]) -> list[dict[str, Any]]
     return out
 
 
-_UNITS = {"mass": "kg", "fc": "N", "hump": "N", "sigma2": "N s/m", "vs": "m/s",
-          "sigma0": "N/m", "sigma1": "N s/m"}
-
-
 def _move_words(m: dict[str, Any]) -> str:
-    from .fitreport import label
+    from .fitreport import fit_unit, label
 
-    unit = _UNITS[m["name"].split(".")[-1]]
-    return f"{label(m['name'])} {m['given']:.4g} -> {m['refit']:.4g} {unit}"
+    return f"{label(m['name'])} {m['given']:.4g} -> {m['refit']:.4g} {fit_unit(m['name'])}"
