@@ -273,3 +273,23 @@ def test_fit_page_shows_what_the_record_determines():
     assert "fs - fc (v >= 0)" in text and "open to open N s/m" in text
     doc["identification"]["far_from_floor"] = True
     assert "Check first" in _words(fit_page(doc))
+
+
+def test_a_verdict_never_says_keep_and_add_together():
+    """When the refit does not carry over to the held-out record the verdict says to keep
+    the model and check first, and does not also say to add the findings."""
+    from types import SimpleNamespace
+
+    from lugre.diagnosis.evidence import verdict
+
+    f = SimpleNamespace(effect="cogging", alternatives=[],
+                        parameters={"amplitude": 1.0, "pitch": 0.02, "phase": 0.0})
+    dg = SimpleNamespace(findings=[f], removed=[], rebased=None, base_moves=[],
+                         unexplained=None,
+                         fit={"holdout_before": {"rms_force": 1.0},
+                              "holdout_after": {"rms_force": 1.5}})
+    text = verdict(dg)
+    assert "keep the model as given" in text and "Add it" not in text
+    dg.fit["holdout_after"] = {"rms_force": 0.5}
+    text = verdict(dg)
+    assert "Add it" in text and "keep the model" not in text

@@ -301,17 +301,14 @@ def diagnose(
             rec, model, dg.augmented, cutoff_hz=cutoff_hz, backend=backend,
             free_mass=free_mass)
         if far is not None:
+            first = dg
             dg = _diagnose(rec, far["model"], **kw)
             dg.model = model
-            dg.rebased = {k: v for k, v in far.items() if k != "model"}
-            # the model as given, on this record and the held-out one (the fit's
-            # "before" is the refitted base's)
-            dg.rebased["given"] = {k: v for k, v in evaluate(rec, model).items()
-                                   if k in ("rms_force", "nrmse_force")}
-            if holdout is not None:
-                dg.rebased["holdout_given"] = {
-                    k: v for k, v in evaluate(as_recording(holdout), model).items()
-                    if k in ("rms_force", "nrmse_force")}
+            # the model as given, on this record and the held-out one, from the first
+            # pass (the second's "before" is the refitted base's)
+            dg.rebased = {**{k: v for k, v in far.items() if k != "model"},
+                          "given": first.fit["before"],
+                          "holdout_given": first.fit["holdout_before"] or None}
             dg.verdict = V.verdict(dg)
     if fitted:
         dg.notes.append(

@@ -819,10 +819,12 @@ def verdict(dg: Any) -> str:
     """The verdict in one paragraph: what is wrong, how sure, what to do next."""
     hb, ha = dg.fit.get("holdout_before"), dg.fit.get("holdout_after")
     gain = ""
+    carries = True
     if hb and ha and hb.get("rms_force"):
         gain = (f" On the held-out record the force error goes from {hb['rms_force']:.3g} to "
                 f"{ha['rms_force']:.3g} N rms ({100 * (ha['rms_force'] / hb['rms_force'] - 1):+.0f} %).")
-        if ha["rms_force"] > 1.1 * hb["rms_force"]:
+        carries = not ha["rms_force"] > 1.1 * hb["rms_force"]
+        if not carries:
             # the refit describes this record and not the held-out one: a record unlike
             # its hold-out (an unstable stretch, a changed setup) or a refit gone astray
             gain += (" The refit does not carry over to the held-out record: keep the "
@@ -837,7 +839,7 @@ def verdict(dg: Any) -> str:
                  f"{rebased['holdout_given']['rms_force']:.3g} N rms, the refitted base with "
                  f"what is found below by {ha['rms_force']:.3g} N. ")
     if not gone:
-        return head + _verdict_findings(dg, gain)
+        return head + _verdict_findings(dg, gain, carries=carries)
     # the model's own effects that the record contradicts come first: they are what the
     # user wrote, and the augmented model leaves them out
     def listed(rs: list[dict[str, Any]], who: str = "its") -> str:
@@ -857,11 +859,13 @@ def verdict(dg: Any) -> str:
                    "again without it, the record holds another of its kind (below), which "
                    "replaces it.")
     one = len(gone) == 1
-    return head + " ".join(out) + " " + _verdict_findings(dg, gain,
-                                                   f"without {'it' if one else 'them'}")
+    return head + " ".join(out) + " " + _verdict_findings(
+        dg, gain, f"without {'it' if one else 'them'}", carries=carries)
 
 
-def _verdict_findings(dg: Any, gain: str, without: str = "") -> str:
+def _verdict_findings(dg: Any, gain: str, without: str = "", carries: bool = True) -> str:
+    """The findings' part of the verdict; ``carries``: the refit carries over to the
+    held-out record (else ``gain`` already says to check first, and no "add them")."""
     if not dg.findings:
         txt = ("Nothing found: the model leaves nothing out that this record can show."
                if not without else
@@ -876,7 +880,7 @@ def _verdict_findings(dg: Any, gain: str, without: str = "") -> str:
         return txt + gain
     names = ", ".join(f"{f.effect} ({_params(f)})" for f in dg.findings)
     one = len(dg.findings) == 1
-    if "does not carry over" in gain:  # the advice is already given: check first
+    if not carries:
         txt = f"Found on this record: {names}.{gain}"
     else:
         txt = (f"Found: {names}.{gain} Add {'it' if one else 'them'} to the model (the "
