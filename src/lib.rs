@@ -13,7 +13,8 @@
 //! - [`estimate`] (feature `std`): robust (IRLS) Nelder-Mead identification.
 //! - [`inverse`] (feature `std`): inverse dynamics of a recorded axis, the force
 //!   residual against a model and its sensitivities (the numerics of the diagnosis).
-//! - Python bindings (feature `python`), built by maturin as `lugre._core`.
+//! - The Python bindings are the workspace crate `lugre-python` (`bindings/`), built by
+//!   maturin as `lugre._core`.
 //!
 //! The numerical algorithms are fixed in `docs/DESIGN.md`; the NumPy reference
 //! `lugre.reference` implements the same steps.
@@ -30,9 +31,6 @@ pub mod estimate;
 pub mod inverse;
 #[cfg(feature = "std")]
 pub mod servo;
-
-#[cfg(feature = "python")]
-mod python;
 
 #[cfg(feature = "std")]
 pub use error::{Error, Result};

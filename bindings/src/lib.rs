@@ -1,11 +1,11 @@
 //! Python bindings (`lugre._core`): convert in, call the core with the interpreter
 //! released, convert out. No numerics here.
 
-use crate::error::{check_finite, Error};
-use crate::friction::{
+use lugre::error::{check_finite, Error};
+use lugre::friction::{
     friction_force_general_into, friction_force_into, friction_force_varstep_into,
 };
-use crate::servo::{self, CouplingOptions, Drive, Integrator, SimOptions, SimResult};
+use lugre::servo::{self, CouplingOptions, Drive, Integrator, SimOptions, SimResult};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
@@ -28,6 +28,8 @@ pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
         Error::Input { .. } => "InputError",
         Error::Data(_) => "DataError",
         Error::Interrupted => return PyKeyboardInterrupt::new_err("interrupted"),
+        // the core's error is non-exhaustive: a variant added later maps to the base class
+        _ => "LugreError",
     };
     let msg = e.to_string();
     match py.import("lugre.exceptions").and_then(|m| m.getattr(class)) {
@@ -146,7 +148,7 @@ fn friction_force<'py>(
             return Err(Error::input("dt", "is empty: give the hold interval [s]"));
         }
         if dts.len() != 1 {
-            crate::error::check_len("dt", dts, vs.len(), "v")?;
+            lugre::error::check_len("dt", dts, vs.len(), "v")?;
         }
         check_finite("dt", dts)?;
         if let Some(k) = dts.iter().position(|&h| h < 0.0) {
@@ -159,7 +161,7 @@ fn friction_force<'py>(
             return Err(Error::parameter("z0", z0, "must be finite"));
         }
         if let Some(sc) = sc {
-            crate::error::check_scale(sc, vs.len(), "v")?;
+            lugre::error::check_scale(sc, vs.len(), "v")?;
         }
         Ok(())
     })()

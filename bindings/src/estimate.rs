@@ -5,13 +5,13 @@ use super::results::{
     DynamicFitResult, GridFitResult, LinearFitResult, PlateauResult, StaticFitResult,
 };
 use super::{interruptible, model_of, slice, to_py};
-use crate::error::Error;
-use crate::estimate::{
+use lugre::error::Error;
+use lugre::estimate::{
     fit_dynamic_with, fit_static, irls_linear as irls, irls_linear_grid as irls_grid,
     plateaus_from_recording, Design, DynamicFitOptions, LinearIrlsOptions, PlateauOptions,
     StaticFitOptions, Weighting,
 };
-use crate::servo::Integrator;
+use lugre::servo::Integrator;
 use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use std::borrow::Cow;

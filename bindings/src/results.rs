@@ -4,8 +4,8 @@
 //! vectors (no copy on access); lists and numbers convert on access. Each has a `__repr__`
 //! that says what the result holds. No numerics here.
 
-use crate::estimate::{DirectionFit, DynamicFit, GridFit, LinearFit, Plateaus, StaticFit};
-use crate::servo::SimResult;
+use lugre::estimate::{DirectionFit, DynamicFit, GridFit, LinearFit, Plateaus, StaticFit};
+use lugre::servo::SimResult;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 

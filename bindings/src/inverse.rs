@@ -2,12 +2,12 @@
 //! kernel of the diagnosis (`_core.InverseRecord`). No numerics here.
 
 use super::{slice, to_py};
-use crate::error::Error;
-use crate::estimate::Weighting;
-use crate::inverse::{
+use lugre::error::Error;
+use lugre::estimate::Weighting;
+use lugre::inverse::{
     fit_base as base_fit, position_sums as sums, BaseFitOptions, BaseParam, Lowpass, Record,
 };
-use crate::servo::Model;
+use lugre::servo::Model;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -171,7 +171,7 @@ impl PyInverseRecord {
     /// The parallel low-pass of a signal of the record's length.
     fn filt<'py>(&self, py: Python<'py>, y: PyReadonlyArray1<'py, f64>) -> PyResult<F64Array<'py>> {
         let ys = slice("y", &y).map_err(|e| to_py(py, e))?;
-        crate::error::check_len("y", ys, self.rec.len(), "the record").map_err(|e| to_py(py, e))?;
+        lugre::error::check_len("y", ys, self.rec.len(), "the record").map_err(|e| to_py(py, e))?;
         Ok(py.detach(|| self.rec.filt(ys)).into_pyarray(py))
     }
 
