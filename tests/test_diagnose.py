@@ -547,7 +547,7 @@ def test_a_gain_the_readings_noise_makes_is_no_finding(monkeypatch):
     # acceleration, twice-differentiated encoder noise included, and so "explains" part
     # of the noise in every held-out block. Without the SIMEX check it is named; with
     # it, the gain extrapolated to noise-free readings does not pass
-    from lugre.diagnosis import core
+    from lugre.diagnosis import joint
     from lugre.diagnosis.synth import case
 
     rec, _hold, _bel, truth = case([], seed=21019, axis_seed=3873, kind="p2p",
@@ -559,7 +559,7 @@ def test_a_gain_the_readings_noise_makes_is_no_finding(monkeypatch):
     assert [g["effect"] for g in dropped] == ["resonance"]
     assert not dropped[0]["accepted"]
     assert "A resonance passed the held-out test but is not named" in dg.summary()
-    monkeypatch.setattr(core, "noise_made", lambda *a, **k: {})
+    monkeypatch.setattr(joint, "noise_made", lambda *a, **k: {})
     assert [f.effect for f in diagnose(rec, truth, closed_loop=False).findings] == [
         "resonance"]
 
@@ -892,7 +892,7 @@ def test_a_one_of_a_kind_effect_refined_by_little_is_kept():
     # a refinement is no contradiction: a model's delay within 5 % of what the record
     # prefers stays as given (a lightly damped resonance at 23.7 Hz preferred at 23.6 Hz
     # on a hold-out record had been "replaced"), one 25 % off is replaced
-    from lugre.diagnosis.core import _differs
+    from lugre.diagnosis.question import _differs
 
     assert not _differs({"effect": "resonance", "frequency": 23.7, "damping_ratio": 0.036,
                          "load_fraction": 0.48},
