@@ -9,6 +9,7 @@ use lugre::servo::{self, CouplingOptions, Drive, Integrator, SimOptions, SimResu
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyTuple;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::RecvTimeoutError;
 use std::time::Duration;
@@ -376,5 +377,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(estimate::irls_linear, m)?)?;
     m.add_function(wrap_pyfunction!(estimate::irls_linear_grid, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add(
+        "EFFECT_NAMES",
+        PyTuple::new(m.py(), lugre::servo::EFFECT_NAMES)?,
+    )?;
     Ok(())
 }

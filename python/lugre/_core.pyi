@@ -6,6 +6,7 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "EFFECT_NAMES",
     "DirectionFitResult",
     "DynamicFitResult",
     "GridFitResult",
@@ -32,6 +33,8 @@ __all__ = [
 ]
 
 __version__: str
+#: The effect names of the model file, in the order of the CONTRACT.
+EFFECT_NAMES: tuple[str, ...]
 
 @final
 class Model:

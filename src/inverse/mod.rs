@@ -29,6 +29,7 @@ pub use spectrum::{position_sums, PositionSums, MAX_FREQUENCIES, RESEED};
 use crate::error::{check_finite, check_len, Error, Result};
 use crate::friction::{LugreParams, StaticSet};
 use crate::servo::coupling::coupling_forces;
+use crate::servo::effects::drift_factor;
 use crate::servo::fast::{Fast, Power, Shape, Square};
 use crate::servo::{coupling_force, CouplingOptions, Effect, Model};
 
@@ -286,7 +287,7 @@ impl Record {
                     time_constant,
                 } => {
                     for (o, &t) in f.iter_mut().zip(&self.t) {
-                        *o = 1.0 - gain * (1.0 - (-t / time_constant).exp());
+                        *o = drift_factor(*gain, *time_constant, t);
                     }
                 }
                 _ => continue,
@@ -331,43 +332,15 @@ impl Record {
         out
     }
 
-    /// Unfiltered sum of the effect forces (cogging, spring, offset, drag).
+    /// Unfiltered sum of the effect forces (cogging, spring, offset, drag) at the
+    /// samples, added effect by effect in the order of the model ([`Effect::add_force`]).
     pub fn effect_force(&self, model: &Model) -> Vec<f64> {
-        let mut out = vec![0.0; self.len()];
-        for e in &model.effects {
-            match e {
-                Effect::Cogging {
-                    amplitude,
-                    pitch,
-                    phase,
-                    harmonics,
-                } => {
-                    let w = 2.0 * core::f64::consts::PI / pitch;
-                    for (o, &x) in out.iter_mut().zip(&self.x) {
-                        *o += amplitude * (w * x + phase).sin();
-                    }
-                    for (j, (amp, ph)) in harmonics.iter().enumerate() {
-                        let wj = (j + 2) as f64 * w;
-                        for (o, &x) in out.iter_mut().zip(&self.x) {
-                            *o += amp * (wj * x + ph).sin();
-                        }
-                    }
-                }
-                Effect::Spring { stiffness, x0 } => {
-                    for (o, &x) in out.iter_mut().zip(&self.x) {
-                        *o += stiffness * (x - x0);
-                    }
-                }
-                Effect::Offset { force } => out.iter_mut().for_each(|o| *o += force),
-                Effect::Drag { coefficient } => {
-                    for (o, &v) in out.iter_mut().zip(&self.v) {
-                        *o += coefficient * v.abs() * v;
-                    }
-                }
-                _ => {}
-            }
-        }
-        out
+        let forces: Vec<&Effect> = model.effects.iter().filter(|e| e.is_force()).collect();
+        self.x
+            .iter()
+            .zip(&self.v)
+            .map(|(&x, &v)| forces.iter().fold(0.0, |f, e| e.add_force(f, x, v)))
+            .collect()
     }
 
     /// Unfiltered force the `resonance` coupling passes to the load, the load simulated

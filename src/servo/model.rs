@@ -188,7 +188,7 @@ pub struct Model {
     pub controller: Option<Controller>,
 }
 
-fn get<'a>(obj: &'a Value, key: &str, path: &str) -> Result<&'a Value> {
+pub(super) fn get<'a>(obj: &'a Value, key: &str, path: &str) -> Result<&'a Value> {
     obj.get(key).ok_or_else(|| {
         Error::model(
             &join(path, key),
@@ -197,7 +197,7 @@ fn get<'a>(obj: &'a Value, key: &str, path: &str) -> Result<&'a Value> {
     })
 }
 
-fn join(path: &str, key: &str) -> String {
+pub(super) fn join(path: &str, key: &str) -> String {
     if path.is_empty() {
         key.to_string()
     } else {
@@ -205,7 +205,7 @@ fn join(path: &str, key: &str) -> String {
     }
 }
 
-fn num(obj: &Value, key: &str, path: &str) -> Result<f64> {
+pub(super) fn num(obj: &Value, key: &str, path: &str) -> Result<f64> {
     let v = get(obj, key, path)?;
     as_num(v, &join(path, key))
 }
@@ -220,14 +220,14 @@ fn as_num(v: &Value, path: &str) -> Result<f64> {
     Ok(x)
 }
 
-fn opt_num(obj: &Value, key: &str, path: &str) -> Result<Option<f64>> {
+pub(super) fn opt_num(obj: &Value, key: &str, path: &str) -> Result<Option<f64>> {
     match obj.get(key) {
         None | Some(Value::Null) => Ok(None),
         Some(v) => as_num(v, &join(path, key)).map(Some),
     }
 }
 
-fn positive(x: f64, path: &str) -> Result<f64> {
+pub(super) fn positive(x: f64, path: &str) -> Result<f64> {
     if x > 0.0 {
         Ok(x)
     } else {
@@ -235,7 +235,7 @@ fn positive(x: f64, path: &str) -> Result<f64> {
     }
 }
 
-fn nonneg(x: f64, path: &str) -> Result<f64> {
+pub(super) fn nonneg(x: f64, path: &str) -> Result<f64> {
     if x >= 0.0 {
         Ok(x)
     } else {
@@ -243,7 +243,7 @@ fn nonneg(x: f64, path: &str) -> Result<f64> {
     }
 }
 
-fn num_list(v: &Value, path: &str) -> Result<Vec<f64>> {
+pub(super) fn num_list(v: &Value, path: &str) -> Result<Vec<f64>> {
     let a = v
         .as_array()
         .ok_or_else(|| Error::model(path, "must be a list of numbers"))?;
@@ -289,132 +289,6 @@ pub fn parse_friction(f: &Value, path: &str) -> Result<LugreParams<f64>> {
         err
     })?;
     Ok(p)
-}
-
-/// The effect vocabulary, for error messages.
-const EFFECT_NAMES: &str = "cogging, spring, offset, position_friction, drift, mass, delay, \
-                            current_lag, resonance, deadband, drag, stribeck_shape";
-
-fn parse_effect(e: &Value, path: &str) -> Result<Effect> {
-    let kind = get(e, "effect", path)?
-        .as_str()
-        .ok_or_else(|| Error::model(&join(path, "effect"), "must be a string"))?;
-    let n = |k: &str| num(e, k, path);
-    let p = |k: &str| join(path, k);
-    Ok(match kind {
-        "cogging" => {
-            let harmonics = match e.get("harmonics") {
-                None | Some(Value::Null) => Vec::new(),
-                Some(h) => {
-                    let hp = p("harmonics");
-                    let a = h.as_array().ok_or_else(|| {
-                        Error::model(&hp, "must be a list of [amplitude, phase] pairs")
-                    })?;
-                    a.iter()
-                        .enumerate()
-                        .map(|(k, pair)| {
-                            let q = num_list(pair, &format!("{hp}[{k}]"))?;
-                            if q.len() != 2 {
-                                return Err(Error::model(
-                                    &format!("{hp}[{k}]"),
-                                    "must be [amplitude, phase]",
-                                ));
-                            }
-                            Ok((q[0], q[1]))
-                        })
-                        .collect::<Result<Vec<_>>>()?
-                }
-            };
-            Effect::Cogging {
-                amplitude: n("amplitude")?,
-                pitch: positive(n("pitch")?, &p("pitch"))?,
-                phase: opt_num(e, "phase", path)?.unwrap_or(0.0),
-                harmonics,
-            }
-        }
-        "spring" => Effect::Spring {
-            stiffness: n("stiffness")?,
-            x0: opt_num(e, "x0", path)?.unwrap_or(0.0),
-        },
-        "offset" => Effect::Offset { force: n("force")? },
-        "position_friction" => {
-            let positions = num_list(get(e, "positions", path)?, &p("positions"))?;
-            let scale = num_list(get(e, "scale", path)?, &p("scale"))?;
-            if positions.is_empty() || positions.len() != scale.len() {
-                return Err(Error::model(
-                    &p("scale"),
-                    format!(
-                        "has {} values for {} positions: give one scale per position",
-                        scale.len(),
-                        positions.len()
-                    ),
-                ));
-            }
-            if let Some(k) = positions.windows(2).position(|w| w[1] <= w[0]) {
-                return Err(Error::model(
-                    &format!("{}[{}]", p("positions"), k + 1),
-                    "positions must be strictly increasing",
-                ));
-            }
-            for (k, &s) in scale.iter().enumerate() {
-                positive(s, &format!("{}[{k}]", p("scale")))?;
-            }
-            Effect::PositionFriction { positions, scale }
-        }
-        "drift" => {
-            let gain = n("gain")?;
-            if gain >= 1.0 {
-                return Err(Error::parameter(
-                    &p("gain"),
-                    gain,
-                    "must be below 1 (friction would vanish or turn negative)",
-                ));
-            }
-            Effect::Drift {
-                gain,
-                time_constant: positive(n("time_constant")?, &p("time_constant"))?,
-            }
-        }
-        "mass" => Effect::Mass { delta: n("delta")? },
-        "delay" => Effect::Delay {
-            seconds: nonneg(n("seconds")?, &p("seconds"))?,
-        },
-        "current_lag" => Effect::CurrentLag {
-            bandwidth_hz: positive(n("bandwidth")?, &p("bandwidth"))?,
-        },
-        "resonance" => {
-            let frequency_hz = positive(n("frequency")?, &p("frequency"))?;
-            let damping_ratio = nonneg(n("damping_ratio")?, &p("damping_ratio"))?;
-            let load_fraction = n("load_fraction")?;
-            if !(load_fraction > 0.0 && load_fraction < 1.0) {
-                return Err(Error::parameter(
-                    &p("load_fraction"),
-                    load_fraction,
-                    "must lie strictly between 0 and 1 (the load's share of the total mass)",
-                ));
-            }
-            Effect::Resonance {
-                frequency_hz,
-                damping_ratio,
-                load_fraction,
-            }
-        }
-        "deadband" => Effect::Deadband {
-            current: nonneg(n("current")?, &p("current"))?,
-        },
-        "drag" => Effect::Drag {
-            coefficient: nonneg(n("coefficient")?, &p("coefficient"))?,
-        },
-        "stribeck_shape" => Effect::StribeckShape {
-            exponent: positive(n("exponent")?, &p("exponent"))?,
-        },
-        other => {
-            return Err(Error::model(
-                &join(path, "effect"),
-                format!("unknown effect \"{other}\": use one of {EFFECT_NAMES}"),
-            ))
-        }
-    })
 }
 
 impl Model {
@@ -526,7 +400,7 @@ impl Model {
                     .ok_or_else(|| Error::model("effects", "must be a list"))?;
                 list.iter()
                     .enumerate()
-                    .map(|(k, x)| parse_effect(x, &format!("effects[{k}]")))
+                    .map(|(k, x)| super::effects::parse_effect(x, &format!("effects[{k}]")))
                     .collect::<Result<Vec<_>>>()?
             }
         };

@@ -10,6 +10,7 @@
 //! comparison. The algorithm is fixed in `docs/DESIGN.md` and mirrored step for step by
 //! `lugre.reference`.
 
+use super::effects::{EffectForces, FrictionScale};
 use super::model::{ControlLaw, CurrentLoop, Effect, FeedforwardKind, Model};
 use crate::error::{check_finite, check_len, check_time, Error, Result};
 use crate::friction::{Compensator, LugreParams};
@@ -144,20 +145,16 @@ struct Physics<const EXTRAS: bool> {
     mass: f64,
     kf: f64,
     fr: LugreParams<f64>,
-    lin_a: f64,
-    lin_b: f64,
-    cogging: Vec<(f64, f64, f64)>,
-    pos_scale: Vec<(Vec<f64>, Vec<f64>)>,
-    drift: Vec<(f64, f64)>,
-    has_scale: bool,
+    /// Cogging, springs, offsets and drag.
+    forces: EffectForces,
+    /// `position_friction` and `drift`.
+    scales: FrictionScale,
     current_loop: Option<CurrentLoop>,
     lag_w: Option<f64>,
     delay: Option<f64>,
     t0: f64,
     /// `stribeck_shape` exponent.
     shape: Option<f64>,
-    /// `drag` coefficient (0 without drag).
-    drag: f64,
     /// `deadband` half-width [A].
     deadband: Option<f64>,
     /// Two-mass `resonance`.
@@ -196,20 +193,6 @@ impl TwoMass {
     }
 }
 
-fn interp_clamped(xp: &[f64], fp: &[f64], x: f64) -> f64 {
-    let n = xp.len();
-    if x <= xp[0] {
-        return fp[0];
-    }
-    if x >= xp[n - 1] {
-        return fp[n - 1];
-    }
-    // binary search: first index with xp[j] > x
-    let j = xp.partition_point(|&p| p <= x);
-    let (x0, x1) = (xp[j - 1], xp[j]);
-    fp[j - 1] + (fp[j] - fp[j - 1]) * (x - x0) / (x1 - x0)
-}
-
 /// True when the model needs none of the extras of [`Physics`].
 fn is_plain(m: &Model) -> bool {
     m.axis.current_loop.is_none()
@@ -228,48 +211,18 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
             mass: m.total_mass(),
             kf: m.axis.force_constant,
             fr: m.friction,
-            lin_a: 0.0,
-            lin_b: 0.0,
-            cogging: Vec::new(),
-            pos_scale: Vec::new(),
-            drift: Vec::new(),
-            has_scale: false,
+            forces: EffectForces::new(&m.effects),
+            scales: FrictionScale::new(&m.effects),
             current_loop: m.axis.current_loop.clone(),
             lag_w: None,
             delay: None,
             t0,
             shape: None,
-            drag: 0.0,
             deadband: None,
             res: None,
         };
         for e in &m.effects {
             match e {
-                Effect::Cogging {
-                    amplitude,
-                    pitch,
-                    phase,
-                    harmonics,
-                } => {
-                    let w = 2.0 * PI / pitch;
-                    p.cogging.push((*amplitude, w, *phase));
-                    for (k, (a, ph)) in harmonics.iter().enumerate() {
-                        p.cogging.push((*a, w * (k as f64 + 2.0), *ph));
-                    }
-                }
-                Effect::Spring { stiffness, x0 } => {
-                    p.lin_a += stiffness;
-                    p.lin_b -= stiffness * x0;
-                }
-                Effect::Offset { force } => p.lin_b += force,
-                Effect::PositionFriction { positions, scale } => {
-                    p.pos_scale.push((positions.clone(), scale.clone()))
-                }
-                Effect::Drift {
-                    gain,
-                    time_constant,
-                } => p.drift.push((*gain, *time_constant)),
-                Effect::Mass { .. } => {}
                 Effect::Delay { seconds } => p.delay = Some(*seconds),
                 Effect::CurrentLag { bandwidth_hz } => p.lag_w = Some(2.0 * PI * bandwidth_hz),
                 Effect::Resonance {
@@ -285,11 +238,17 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
                     ))
                 }
                 Effect::Deadband { current } => p.deadband = Some(*current),
-                Effect::Drag { coefficient } => p.drag += coefficient,
                 Effect::StribeckShape { exponent } => p.shape = Some(*exponent),
+                // forces and friction scales: `forces`, `scales`; mass: `total_mass`
+                Effect::Cogging { .. }
+                | Effect::Spring { .. }
+                | Effect::Offset { .. }
+                | Effect::PositionFriction { .. }
+                | Effect::Drift { .. }
+                | Effect::Drag { .. }
+                | Effect::Mass { .. } => {}
             }
         }
-        p.has_scale = !p.pos_scale.is_empty() || !p.drift.is_empty();
         p
     }
 
@@ -322,17 +281,10 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
 
     #[inline(always)]
     fn scale(&self, x: f64, time: f64) -> f64 {
-        if !(EXTRAS && self.has_scale) {
+        if !EXTRAS || self.scales.is_empty() {
             return 1.0;
         }
-        let mut s = 1.0;
-        for (xp, fp) in &self.pos_scale {
-            s *= interp_clamped(xp, fp, x);
-        }
-        for &(gain, tau) in &self.drift {
-            s *= 1.0 - gain * (1.0 - (-(time - self.t0) / tau).exp());
-        }
-        s
+        self.scales.at(x, time - self.t0)
     }
 
     #[inline(always)]
@@ -386,16 +338,12 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
 
     #[inline(always)]
     fn effect_force(&self, x: f64, v: f64) -> f64 {
-        let mut f = self.lin_a * x + self.lin_b;
+        let f = self.forces.linear(x);
         if EXTRAS {
-            for &(a, w, ph) in &self.cogging {
-                f += a * (w * x + ph).sin();
-            }
-            if self.drag != 0.0 {
-                f += self.drag * v.abs() * v;
-            }
+            self.forces.add_nonlinear(f, x, v)
+        } else {
+            f
         }
-        f
     }
 
     #[inline(always)]
