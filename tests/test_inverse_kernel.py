@@ -53,7 +53,7 @@ KERNELS = ("base_friction", "effect_force", "model_force", "motor_force", "resid
 @pytest.fixture(scope="module")
 def pair():
     rec, model, _ = concealed("cogging", duration=3.0)
-    return (R.prepare(rec, model), R.prepare(rec, model, backend="reference"), model)
+    return (R.prepare(rec, model), R.prepare(rec, model, backend=reference.kernels), model)
 
 
 def _rel(a: np.ndarray, b: np.ndarray) -> float:
@@ -88,7 +88,7 @@ def test_kernels_twins_on_independent_plant():
     model = lugre.load_model(case / "model.json")
     n = 3000
     rec = lugre.Recording(t=rec.t[:n], x=rec.x[:n], i=rec.i[:n])
-    sig, sigr = R.prepare(rec, model), R.prepare(rec, model, backend="reference")
+    sig, sigr = R.prepare(rec, model), R.prepare(rec, model, backend=reference.kernels)
     aug = model.replace(effects=[{"effect": "resonance", "frequency": 22.0,
                                   "damping_ratio": 0.04, "load_fraction": 0.75}])
     for m in (model, aug):

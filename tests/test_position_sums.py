@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from lugre import _native, reference
-from lugre.diagnosis import effects as E
+from lugre.diagnosis import candidates as E
 from lugre.diagnosis import residual as R
 from lugre.diagnosis.synth import concealed
 from lugre.exceptions import InputError, ParameterError
@@ -98,7 +98,7 @@ def test_numpy_integer_count_and_empty_samples():
 def record():
     rec, model, _ = concealed("cogging", duration=6.0)
     sig = R.prepare(rec, model)
-    sigr = R.prepare(rec, model, backend="reference")
+    sigr = R.prepare(rec, model, backend=reference.kernels)
     return sig, sigr, sig.kernel.residual(model), model
 
 

@@ -1112,7 +1112,7 @@ def test_steady_state_points_twins_generated(case):
     kernels (the core's binding and its twin) with an explicit velocity window, which the
     facade leaves automatic."""
     from lugre import _core
-    from lugre._reference_plateaus import plateaus
+    from lugre.reference.plateaus import plateaus
 
     t, x, F, v_ref, opts, window = case
     rec = lugre.Recording(t=t, x=x, F=F, v_ref=v_ref)
@@ -1242,7 +1242,7 @@ def test_plateau_kernel_bad_input_same_errors(desc, args, text):
     """The kernels check their arrays themselves, in the same order, with the same
     words, whatever the facade let through."""
     from lugre import _core
-    from lugre._reference_plateaus import plateaus
+    from lugre.reference.plateaus import plateaus
 
     msgs = []
     for kernel in (_core.plateaus, plateaus):

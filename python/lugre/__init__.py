@@ -17,8 +17,11 @@ from __future__ import annotations
 from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
+from . import _entry
+from ._entry import table_or_same
 from ._native import friction_force, load_coupling, simulate, simulate_batch, stribeck
 from ._result import CouplingResult, SimResult
+from ._version import __version__ as __version__
 from .exceptions import (
     ConvergenceWarning,
     DataError,
@@ -39,7 +42,6 @@ if TYPE_CHECKING:  # pragma: no cover
     from .diagnosis import Diagnosis
     from .identify import DynamicFit, StaticFit, SteadyStatePoints, fit_static
 
-__version__ = "0.1.0"
 
 #: Names imported on first use, with the module that defines them.
 _LAZY = {
@@ -76,45 +78,20 @@ def diagnose(recording: Any, model: Any, **kwargs: Any) -> Any:
     (:func:`lugre.checks.require_plausible`). See :func:`lugre.diagnosis.diagnose` for
     the options and the result.
     """
-    from .checks import require_plausible
-    from .diagnosis import diagnose as _diagnose
-    from .tabular import as_recording
-
-    # the recording is checked first thing by the diagnosis; the hold-out only at its
-    # end, so it is checked here, before the work
-    hold = kwargs.get("holdout")
-    if hold is not None:
-        kwargs["holdout"] = require_plausible(as_recording(hold, "holdout"))
-    return _diagnose(as_recording(recording), model, **kwargs)
+    return _entry.diagnose(recording, model, **kwargs)
 
 
 def evaluate(recording: Any, model: Any, **kwargs: Any) -> Any:
     """The inverse-dynamics force residual of ``model`` on ``recording`` (``rms_force``
     [N], ``nrmse_force``, ...). ``recording`` is taken as by :func:`diagnose`; see
     :func:`lugre.diagnosis.evaluate`."""
-    from .diagnosis import evaluate as _evaluate
-    from .tabular import as_recording
-
-    return _evaluate(as_recording(recording), model, **kwargs)  # checked by the diagnosis
-
-
-def _table_or_same(recording: Any) -> Any:
-    """A table with named columns as a :class:`Recording`; anything else unchanged (paths
-    and recordings are read and checked where they are used)."""
-    from .tabular import as_recording, table_columns
-
-    if (isinstance(recording, (Recording, str, bytes)) or hasattr(recording, "__fspath__")
-            or table_columns(recording) is None):
-        return recording
-    return as_recording(recording)
+    return _entry.evaluate(recording, model, **kwargs)
 
 
 def fit_inverse_dynamics(recording: Any, *args: Any, **kwargs: Any) -> Any:
     """Mass and LuGre friction by robust inverse dynamics; ``recording`` may be a table
     with named columns. See :func:`lugre.diagnosis.fit_inverse_dynamics`."""
-    from .diagnosis import fit_inverse_dynamics as _fit
-
-    return _fit(_table_or_same(recording), *args, **kwargs)
+    return _entry.fit_inverse_dynamics(recording, *args, **kwargs)
 
 
 def fit_model(recording: Any, **kwargs: Any) -> Any:
@@ -122,9 +99,7 @@ def fit_model(recording: Any, **kwargs: Any) -> Any:
     parameter's interval, what the record leaves open and how far the fit is from the
     record's noise floor; ``recording`` may be a table with named columns. See
     :func:`lugre.diagnosis.fit_model`."""
-    from .diagnosis import fit_model as _fit
-
-    return _fit(_table_or_same(recording), **kwargs)
+    return _entry.fit_model(recording, **kwargs)
 
 
 def fit_dynamic(recording: Any, *args: Any, **kwargs: Any) -> Any:
@@ -132,7 +107,7 @@ def fit_dynamic(recording: Any, *args: Any, **kwargs: Any) -> Any:
     named columns. See :func:`lugre.identify.fit_dynamic`."""
     from .identify import fit_dynamic as _fit
 
-    return _fit(_table_or_same(recording), *args, **kwargs)
+    return _fit(table_or_same(recording), *args, **kwargs)
 
 
 def steady_state_points(recording: Any, *args: Any, **kwargs: Any) -> Any:
@@ -140,7 +115,7 @@ def steady_state_points(recording: Any, *args: Any, **kwargs: Any) -> Any:
     named columns. See :func:`lugre.identify.steady_state_points`."""
     from .identify import steady_state_points as _points
 
-    return _points(_table_or_same(recording), *args, **kwargs)
+    return _points(table_or_same(recording), *args, **kwargs)
 
 
 __all__ = [

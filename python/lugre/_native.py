@@ -1,8 +1,10 @@
 """The public simulation API over the Rust core (:mod:`lugre._core`).
 
 Each function has the same name, signature and results as its twin in
-:mod:`lugre.reference`; Python only normalises inputs (dtype, layout, dimensions) and
-the core validates their content, with the same errors.
+:mod:`lugre.reference`; Python only normalises inputs (dtype, layout, dimensions; the
+conversions of :mod:`lugre._args`, shared with the twin) and the core validates their
+content, with the same errors. This module is also the diagnosis's default kernels
+(with the core's ``InverseRecord``); :mod:`lugre.reference.kernels` offers the twins.
 """
 
 from __future__ import annotations
@@ -12,21 +14,35 @@ from typing import Any
 
 import numpy as np
 
-from . import _core
+from ._args import (
+    as_array,
+    check_substeps_type,
+    frequency_count,
+    grid_args,
+    linear_args,
+    select_drive,
+)
+from ._core import InverseRecord
+from ._core import friction_force as core_friction_force
+from ._core import irls_linear as core_irls_linear
+from ._core import irls_linear_grid as core_irls_linear_grid
+from ._core import load_coupling as core_load_coupling
+from ._core import position_sums as core_position_sums
+from ._core import simulate as core_simulate
+from ._core import simulate_batch as core_simulate_batch
+from ._core import stribeck as core_stribeck
 from ._result import CouplingResult, GridFit, LinearFit, SimResult
-from .exceptions import InputError
+from .exceptions import InputError, ParameterError
 from .model import ModelLike, _as_model
-from .reference import _array as _ref_array
-from .reference import _check_substeps_type, _select_drive
 
-__all__ = ["friction_force", "irls_linear", "irls_linear_grid", "load_coupling",
+__all__ = ["InverseRecord", "friction_force", "irls_linear", "irls_linear_grid", "load_coupling",
            "position_sums", "simulate", "simulate_batch", "stribeck"]
 
 
 def _array(name: str, a: Any) -> np.ndarray:
-    """The reference's 1-D float64 array (same checks, same messages: a scalar is
-    refused by both), made contiguous for the core."""
-    return np.ascontiguousarray(_ref_array(name, a))
+    """The twins' 1-D float64 array (same checks, same messages: a scalar is refused by
+    both), made contiguous for the core."""
+    return np.ascontiguousarray(as_array(name, a))
 
 
 def _core_model(model: ModelLike) -> Any:
@@ -58,7 +74,7 @@ def stribeck(v: Any, model: ModelLike) -> np.ndarray:
     >>> float(lugre.stribeck([0.4], lugre.Model.paper())[0])
     161.7
     """
-    return _core.stribeck(_array("v", v), _core_model(model))
+    return core_stribeck(_array("v", v), _core_model(model))
 
 
 def friction_force(
@@ -105,7 +121,7 @@ def friction_force(
         dta = np.ascontiguousarray(dt, dtype=np.float64).reshape(-1)
     except (TypeError, ValueError) as e:
         raise InputError.at("dt", f"must be a number or an array of numbers ({e})") from None
-    f, z = _core.friction_force(vv, dta, _core_model(model), _float("z0", z0), bool(return_z),
+    f, z = core_friction_force(vv, dta, _core_model(model), _float("z0", z0), bool(return_z),
                                 sc)
     return (f, z) if return_z else f
 
@@ -174,7 +190,7 @@ def load_coupling(
     ex = None if extra is None else _array("extra", extra)
     dtf = _float("dt", dt)
     n_sub = _substeps(substeps)
-    f, xl, vl, z = _core.load_coupling(xx, vv, dtf, mj, sc, ex, _float("z0", z0), n_sub)
+    f, xl, vl, z = core_load_coupling(xx, vv, dtf, mj, sc, ex, _float("z0", z0), n_sub)
     return CouplingResult(f, xl, vl, z)
 
 
@@ -193,13 +209,11 @@ def position_sums(x: Any, r: Any, k0: float, dk: float, n: int, *, squares: bool
         ``(S, C)``, with ``squares`` ``(S, C, SS, CC, SC)``: the sums of ``sin*r``,
         ``cos*r``, ``sin^2``, ``cos^2`` and ``sin*cos``, each of length ``n``.
     """
-    from ._reference_inverse import frequency_count
-
     xx = _array("x", x)
     rr = _array("r", r)
     k0f, dkf = _float("k0", k0), _float("dk", dk)
     nn = frequency_count(n)
-    return tuple(_core.position_sums(xx, rr, k0f, dkf, nn, bool(squares)))
+    return tuple(core_position_sums(xx, rr, k0f, dkf, nn, bool(squares)))
 
 
 def irls_linear(x: Any, y: Any, *, weighting: str = "igg", rounds: int = 8) -> LinearFit:
@@ -213,10 +227,8 @@ def irls_linear(x: Any, y: Any, *, weighting: str = "igg", rounds: int = 8) -> L
     LinearFit
         ``coef``, ``weights``, ``residuals``, ``sse`` and ``scale``.
     """
-    from ._reference_linear import fit_result, linear_args
-
     xa, ya, name, nr = linear_args(x, y, weighting, rounds)
-    return fit_result(_core.irls_linear(np.asfortranarray(xa), np.ascontiguousarray(ya),
+    return fit_result(core_irls_linear(np.asfortranarray(xa), np.ascontiguousarray(ya),
                                         name, nr))
 
 
@@ -232,25 +244,27 @@ def irls_linear_grid(x: Any, extras: Any, y: Any, *, weighting: str = "igg", rou
     GridFit
         ``chosen``, ``fit``, ``base_sse`` and ``sse``.
     """
-    from ._reference_linear import fit_result, grid_args
-
     xa, cands, ya, name, nr, rt = grid_args(x, extras, y, weighting, rounds, ratio)
-    g = _core.irls_linear_grid(np.asfortranarray(xa), [np.asfortranarray(c) for c in cands],
+    g = core_irls_linear_grid(np.asfortranarray(xa), [np.asfortranarray(c) for c in cands],
                                np.ascontiguousarray(ya), name, nr, rt)
     return GridFit(chosen=g.chosen, fit=fit_result(g.fit), base_sse=g.base_sse, sse=g.sse)
+
+
+def fit_result(f: Any) -> LinearFit:
+    """A :class:`LinearFit` from the core's ``_core.LinearFitResult``."""
+    return LinearFit(coef=f.coef, weights=f.weights, residuals=f.residuals, sse=f.sse,
+                     scale=f.scale)
 
 
 def _float(name: str, value: Any) -> float:
     try:
         return float(value)
     except (TypeError, ValueError):
-        from .exceptions import ParameterError
-
         raise ParameterError.invalid(name, value, "must be a finite number") from None
 
 
 def _drive(x_ref: Any, v_ref: Any, current: Any) -> tuple[str, np.ndarray]:
-    kind, a = _select_drive(x_ref, v_ref, current)
+    kind, a = select_drive(x_ref, v_ref, current)
     return kind, _array(kind, a)
 
 
@@ -294,7 +308,7 @@ def simulate(
         ``t``, ``x``, ``v``, ``z``, ``i``, ``friction`` and ``force`` at ``t``.
     """
     tt, args = _sim_args(t, x_ref, v_ref, current, integrator, substeps, z0, x0, v0)
-    r = _core.simulate(_core_model(model), tt, *args)
+    r = core_simulate(_core_model(model), tt, *args)
     return SimResult(tt.copy(), r.x, r.v, r.z, r.i, r.friction, r.force)
 
 
@@ -310,7 +324,7 @@ def _sim_args(t: Any, x_ref: Any, v_ref: Any, current: Any, integrator: Any, sub
 
 def _substeps(substeps: Any) -> int:
     """Integer check as in the reference; the core checks the range (>= 1)."""
-    _check_substeps_type(substeps)
+    check_substeps_type(substeps)
     return max(int(substeps), 0)
 
 
@@ -337,7 +351,7 @@ def simulate_batch(
         One per model, in order.
     """
     tt, args = _sim_args(t, x_ref, v_ref, current, integrator, substeps, z0, x0, v0)
-    rs = _core.simulate_batch([_core_model(m) for m in models], tt, *args)
+    rs = core_simulate_batch([_core_model(m) for m in models], tt, *args)
     return [SimResult(tt.copy(), r.x, r.v, r.z, r.i, r.friction, r.force) for r in rs]
 
 

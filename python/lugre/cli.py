@@ -484,7 +484,7 @@ def _add(sub: Any, name: str, help: str, common: list[argparse.ArgumentParser]) 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand."""
-    from . import __version__
+    from ._version import __version__
 
     p = _Parser(
         prog="lugre",

@@ -89,7 +89,7 @@ _COLOURS = ["#c0392b", "#2471a3", "#d68910", "#7d3c98", "#138d75", "#a04000", "#
 
 
 def _page(title: str, body: str, subtitle: str = "") -> str:
-    from . import __version__
+    from ._version import __version__
 
     stamp = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     return (

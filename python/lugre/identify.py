@@ -14,12 +14,12 @@ none) with Nelder-Mead inside, as in the paper, with standard errors at the opti
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
 
-from . import _core
+from ._core import fit_dynamic_record, fit_static_points, plateaus
+from ._fits import STATIC_NAMES, DirectionFit, DynamicFit, StaticFit, SteadyStatePoints
 from ._native import _array
 from .exceptions import ConvergenceWarning, DataError, IdentifiabilityWarning, InputError
 from .io import Recording, read_recording
@@ -35,111 +35,6 @@ __all__ = [
     "steady_state_points",
     "stribeck_determinacy",
 ]
-
-STATIC_NAMES = ("fc", "fs", "sigma2", "vs")
-
-
-@dataclass
-class DirectionFit:
-    """Stribeck fit of one direction (all parameters positive, also for ``v < 0``)."""
-
-    params: dict[str, float]
-    """``fc`` [N], ``fs`` [N], ``sigma2`` [N s/m], ``vs`` [m/s]."""
-    std_err: dict[str, float]
-    """Standard errors (NaN where they cannot be computed)."""
-    ci95: dict[str, tuple[float, float]]
-    """95 % confidence intervals."""
-    indices: np.ndarray
-    """Indices of this direction's points in the input."""
-    weights: np.ndarray
-    """Final IRLS weight of each of these points (0: rejected as a gross error)."""
-    residuals: np.ndarray
-    """``F - F_model`` at each of these points [N]."""
-    scale: float
-    """Robust residual scale (1.4826 MAD) [N]."""
-    iterations: int
-    converged: bool
-    cov: np.ndarray = field(default_factory=lambda: np.full((4, 4), np.nan))
-    """Joint covariance of ``fc, fs, sigma2, vs`` (NaN where it cannot be computed)."""
-
-    @classmethod
-    def _from_core(cls, d: Any) -> DirectionFit:
-        """From a direction's result: the core's ``_core.DirectionFitResult`` or its
-        twin's (same attributes)."""
-        return cls(
-            params={k: float(getattr(d, k)) for k in STATIC_NAMES},
-            std_err=dict(zip(STATIC_NAMES, map(float, d.std_err))),
-            ci95={k: (float(lo), float(hi))
-                  for k, lo, hi in zip(STATIC_NAMES, d.ci_low, d.ci_high)},
-            indices=np.asarray(d.indices, dtype=np.intp),
-            weights=d.weights,
-            residuals=d.residuals,
-            scale=float(d.scale),
-            iterations=int(d.iterations),
-            converged=bool(d.converged),
-            cov=np.asarray(d.cov, dtype=float).reshape(4, 4),
-        )
-
-
-@dataclass
-class StaticFit:
-    """Result of :func:`fit_static`."""
-
-    positive: DirectionFit
-    negative: DirectionFit
-    weights: np.ndarray
-    """Final weight of every input point (0 for rejected and zero-speed points)."""
-    rejected: list[int]
-    """Indices of the points rejected as gross errors."""
-    n_zero_speed: int
-    weighting: str
-    notes: list[str] = field(default_factory=list)
-
-    @property
-    def converged(self) -> bool:
-        """True when both directions converged."""
-        return self.positive.converged and self.negative.converged
-
-    def to_model(self, base: ModelLike | None = None, **axis: float) -> Model:
-        """A model with these static sets.
-
-        Parameters
-        ----------
-        base : Model, dict or path, optional
-            Supplies the axis, sigma0, sigma1, effects and controller. Without it the
-            paper's axis values are used for what the static step cannot tell, and the
-            model is marked ``"identified": {"static": true, "dynamic": false}``.
-        **axis
-            ``mass=``, ``force_constant=`` override the axis.
-        """
-        d = (_as_model(base) if base is not None else Model.paper()).to_dict()
-        d["friction"]["positive"] = dict(self.positive.params)
-        d["friction"]["negative"] = dict(self.negative.params)
-        d["axis"].update({k: float(v) for k, v in axis.items()})
-        if base is None:
-            d.pop("controller", None)
-            d["identified"] = {"static": True, "dynamic": False}
-        return Model.from_dict(d)
-
-    def summary(self, truth: dict[str, dict[str, float]] | None = None) -> str:
-        """A table a person reads: estimates, 95 % intervals, and errors against ``truth``
-        (``{"positive": {...}, "negative": {...}}``) when given."""
-        lines = [(f"static fit ({self.weighting} weights): {len(self.rejected)} points "
-                 f"rejected as gross errors {self.rejected}")]
-        for name, d in (("v > 0", self.positive), ("v < 0", self.negative)):
-            lines.append(f"  {name}  (IRLS iterations {d.iterations}, "
-                         f"{'converged' if d.converged else 'NOT converged'}, "
-                         f"residual scale {d.scale:.3g} N)")
-            for k in STATIC_NAMES:
-                lo, hi = d.ci95[k]
-                row = f"    {k:7s} {d.params[k]:12.6g}   95 % CI [{lo:.6g}, {hi:.6g}]"
-                if truth is not None:
-                    key = "positive" if d is self.positive else "negative"
-                    tv = truth[key][k]
-                    row += f"   truth {tv:.6g}  error {100 * (d.params[k] - tv) / tv:+.2f} %"
-                lines.append(row)
-        lines += [f"  note: {n}" for n in self.notes]
-        return "\n".join(lines)
 
 
 def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
@@ -187,7 +82,7 @@ def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
     >>> round(fit.positive.params["fs"], 3)
     60.2
     """
-    r = _core.fit_static_points(_array("v", v), _array("F", F), str(weighting),
+    r = fit_static_points(_array("v", v), _array("F", F), str(weighting),
                                 int(max_iter), float(scale_floor), int(max_start_points))
     fit = StaticFit(
         positive=DirectionFit._from_core(r.positive),
@@ -202,25 +97,6 @@ def fit_static(v: Any, F: Any, *, weighting: str = "igg", max_iter: int = 20,
         warnings.warn("static fit: IRLS reached its iteration limit before the weights "
                       "settled; check the rejected points", ConvergenceWarning, stacklevel=2)
     return fit
-
-
-@dataclass
-class SteadyStatePoints:
-    """Steady-state points found in a raw constant-velocity record."""
-
-    v: np.ndarray
-    """Mean measured velocity of each point [m/s]."""
-    F: np.ndarray
-    """Mean force of each point [N]."""
-    F_std: np.ndarray
-    """Standard deviation of the force samples behind each point [N]."""
-    plateaus: list[dict[str, Any]]
-    """Every detected plateau: start/end sample, nominal velocity, first sample used,
-    whether it settled."""
-    used: np.ndarray
-    """Boolean mask of the samples that went into a point."""
-    notes: list[str]
-    """What was skipped and why."""
 
 
 def steady_state_points(recording: Recording | str, force_constant: float | None = None, *,
@@ -246,7 +122,7 @@ def steady_state_points(recording: Recording | str, force_constant: float | None
     settle_fraction, velocity_tolerance, chunks, min_samples
         See above; ``chunks > 1`` cuts each settled plateau into replicate points.
     """
-    return _steady_state_points(_core.plateaus, recording, force_constant, columns=columns,
+    return _steady_state_points(plateaus, recording, force_constant, columns=columns,
                                 settle_fraction=settle_fraction,
                                 velocity_tolerance=velocity_tolerance, chunks=chunks,
                                 min_samples=min_samples)
@@ -277,52 +153,6 @@ def _steady_state_points(plateaus: Callable[..., Any],
                               "kind of reason (see .plateaus)")]
     return SteadyStatePoints(v=r.v, F=r.F, F_std=r.F_std, plateaus=plateaus,
                              used=np.asarray(r.used, dtype=bool), notes=notes)
-
-
-@dataclass
-class DynamicFit:
-    """Result of :func:`fit_dynamic`."""
-
-    sigma0: float
-    sigma1: float
-    std_err: dict[str, float]
-    ci95: dict[str, tuple[float, float]]
-    identifiable: dict[str, bool]
-    """Whether the record determines each parameter (95 % interval within +-50 %, and
-    within +-25 % once the static step's uncertainty is carried over)."""
-    correlation: float
-    """Correlation of the ln(sigma0) and ln(sigma1) estimates."""
-    notes: list[str]
-    """Plain-language verdicts and the experiments that would determine the rest."""
-    residuals: np.ndarray
-    """Measured minus simulated position [m]."""
-    weights: np.ndarray
-    rms_error: float
-    max_error: float
-    iterations: int
-    evaluations: int
-    converged: bool
-    model: Model
-    """The input model with the estimated sigma0 and sigma1."""
-
-    def to_model(self) -> Model:
-        """The model with the estimated sigma0 and sigma1."""
-        return self.model.copy()
-
-    def summary(self, truth: dict[str, float] | None = None) -> str:
-        """Estimates, intervals, verdicts (and errors against ``truth`` when given)."""
-        lines = [(f"dynamic fit: {self.evaluations} closed-loop simulations, "
-                 f"rms position error {self.rms_error:.3g} m, max {self.max_error:.3g} m")]
-        for k in ("sigma0", "sigma1"):
-            val = getattr(self, k)
-            lo, hi = self.ci95[k]
-            row = (f"  {k:7s} {val:12.6g}   95 % CI [{lo:.6g}, {hi:.6g}]   "
-                   f"{'determined' if self.identifiable[k] else 'NOT determined by this record'}")
-            if truth is not None and k in truth:
-                row += f"   truth {truth[k]:.6g}  error {100 * (val - truth[k]) / truth[k]:+.2f} %"
-            lines.append(row)
-        lines += [f"  note: {n}" for n in self.notes]
-        return "\n".join(lines)
 
 
 def _check_stick_slip(rec: Recording) -> None:
@@ -547,7 +377,7 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
     """
     def core(mm: Model, rec: Recording, s0: float | None, s1: float | None,
              use_grid: bool) -> Any:
-        return _core.fit_dynamic_record(
+        return fit_dynamic_record(
             mm._core_model(), rec.t, rec.x_ref, rec.x, str(weighting), float(c1),
             float(c2), s0, s1, use_grid, int(max_iter), float(scale_floor), int(substeps),
             str(integrator))

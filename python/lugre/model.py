@@ -634,9 +634,9 @@ class Model:
         use and kept: a model does not change, so every call of the core takes this one
         instead of parsing the JSON again."""
         if self._core is None:
-            from . import _core
+            from ._core import Model as CoreModel
 
-            self._core = _core.Model(self.to_json(indent=None))
+            self._core = CoreModel(self.to_json(indent=None))
         return self._core
 
     def copy(self) -> Model:

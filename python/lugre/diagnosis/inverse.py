@@ -25,7 +25,7 @@ def fit_inverse_dynamics(
     sigma0: float | None = None,
     cutoff_hz: float | None = None,
     controller: dict[str, Any] | None = None,
-    backend: str = "core",
+    backend: Any = "core",
     sliding: float | None = None,
 ) -> Model:
     """Fit a LuGre axis model by robust least squares on the inverse dynamics.
@@ -54,8 +54,10 @@ def fit_inverse_dynamics(
         Low-pass cut-off (default ``fs/25``).
     controller : dict, optional
         Controller section to put in the model.
-    backend : {"core", "reference"}, default "core"
-        The compiled inverse-dynamics kernel and robust fit, or their NumPy twins.
+    backend : "core" or module, default "core"
+        The kernels (:func:`lugre.diagnosis.residual.kernels`): the compiled
+        inverse-dynamics kernel and robust fit, or their NumPy twins
+        (:mod:`lugre.reference.kernels`).
     sliding : float, optional
         Use only the samples moving faster than this share of the largest speed (and
         than ten encoder counts per sample): where the axis slides, the static curve is
@@ -99,10 +101,7 @@ def fit_inverse_dynamics(
         extras.append(np.column_stack([sig.filt(pos * e), sig.filt(-neg * e)])[m])
     # robust (IGG-weighted IRLS) fit of the base and of each candidate, the best kept:
     # the core's estimate::irls_linear_grid or its NumPy twin
-    kernels = sig.backend
-    if kernels is None:
-        from .. import _native as kernels
-    found = kernels.irls_linear_grid(X, extras, y[m])
+    found = R.kernels(sig.backend).irls_linear_grid(X, extras, y[m])
     vs = float(grid[found.chosen]) if found.chosen is not None else None
     b = found.fit.coef
     off = 0 if mass is not None else 1
@@ -146,7 +145,7 @@ def fit_model(
     force_constant: float = 1.0,
     cutoff_hz: float | None = None,
     screw_lead: float | None = None,
-    backend: str = "core",
+    backend: Any = "core",
 ) -> tuple[Model, Any]:
     """Identify an axis model from a recording, with extra physics when asked.
 
@@ -173,8 +172,9 @@ def fit_model(
         Low-pass cut-off (default ``fs/25``).
     screw_lead : float, optional
         Ball-screw lead [m] (tried for cogging).
-    backend : {"core", "reference"}, default "core"
-        The kernels of the compiled core or of the NumPy twin.
+    backend : "core" or module, default "core"
+        The kernels (:func:`lugre.diagnosis.residual.kernels`) of the compiled core, or
+        the NumPy twins (:mod:`lugre.reference.kernels`).
 
     Returns
     -------

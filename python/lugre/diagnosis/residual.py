@@ -158,12 +158,12 @@ class Signals:
         Measured position.
     force_raw : numpy.ndarray
         Motor force as recorded.
-    kernel : lugre._core.InverseRecord or lugre.reference.InverseRecord
+    kernel : InverseRecord of the kernels
         The inverse-dynamics kernel over these signals (residual, model force,
         sensitivities, the parallel low-pass).
     backend : module
-        ``lugre._native`` or ``lugre.reference``: where the diagnosis takes its other
-        numerics (simulation) from.
+        The kernels the signals were prepared with (:func:`kernels`): where the
+        diagnosis takes its other numerics (simulation, periodogram, robust fits) from.
     """
 
     t: np.ndarray
@@ -316,7 +316,7 @@ def prepare(
     cutoff_hz: float | None = None,
     drive_cutoff_hz: float | None = None,
     t0: float | None = None,
-    backend: str = "core",
+    backend: Any = "core",
 ) -> Signals:
     """Filter a recording and take its derivatives for inverse dynamics.
 
@@ -334,8 +334,10 @@ def prepare(
         Low-pass of the velocity that drives the bristles; default ``fs/6``.
     t0 : float, optional
         Time origin for time-dependent effects (drift); default the first sample.
-    backend : {"core", "reference"}, default "core"
-        The compiled kernel, or its NumPy twin (same results, for checking).
+    backend : "core" or module, default "core"
+        The kernels (:func:`kernels`): ``"core"`` for the compiled ones of
+        :mod:`lugre._native`, or a module offering the same names, such as the NumPy
+        twins of :mod:`lugre.reference.kernels` (same results, for checking).
 
     Returns
     -------
@@ -396,22 +398,11 @@ def prepare(
     tt = tr - (rec.t[0] if t0 is None else t0)
     wn = fc / (0.5 * fs)
     sos = _butter(4, wn) if wn < 0.99 else None
-    if backend == "core":
-        from .. import _core
-        from .. import _native as mod
-
-        kernel_cls: Any = _core.InverseRecord
-    elif backend == "reference":
-        from .. import reference as mod
-
-        kernel_cls = mod.InverseRecord
-    else:
-        raise InputError.at("backend", f"unknown backend {backend!r}: use \"core\" or "
-                            "\"reference\"")
+    mod = kernels(backend)
     x, xd, v, a, fm, fm_f = (np.ascontiguousarray(u, dtype=float) for u in (x, xd, v, a, fm, fm_f))
     tt = np.ascontiguousarray(tt, dtype=float)
     padlen = min(_PADLEN, n - 1)
-    kernel = kernel_cls(tt, x, xd, v, a, fm, fm_f, dt, sos, padlen)
+    kernel = mod.InverseRecord(tt, x, xd, v, a, fm, fm_f, dt, sos, padlen)
     return Signals(t=tt, dt=dt, fs=fs, cutoff_hz=fc, x=x, v=v, vf=vf, a=a, fm=fm,
                    fm_f=fm_f, dfm=dfm, spikes=spikes, mask=mask, x_raw=np.array(xr, float),
                    force_raw=force_raw, recording=rec,
@@ -714,10 +705,22 @@ def as_model(m: Any) -> Model:
 def position_sums(sig: Signals, x: np.ndarray, r: np.ndarray, k0: float, dk: float, n: int,
                   squares: bool = False) -> tuple[np.ndarray, ...]:
     """Sums of ``r`` against ``sin`` and ``cos`` of ``2*pi*k_j*x``, ``k_j = k0 + j*dk``
-    (``j < n``), on the backend of ``sig`` (:func:`lugre._native.position_sums` or its
-    NumPy twin :func:`lugre.reference.position_sums`): ``(S, C)``, with ``squares``
-    ``(S, C, SS, CC, SC)``."""
-    backend = sig.backend
-    if backend is None:
-        from .. import _native as backend
-    return tuple(backend.position_sums(x, r, k0, dk, n, squares=squares))
+    (``j < n``), on the kernels of ``sig`` (:func:`lugre._native.position_sums` or its
+    NumPy twin): ``(S, C)``, with ``squares`` ``(S, C, SS, CC, SC)``."""
+    return tuple(kernels(sig.backend).position_sums(x, r, k0, dk, n, squares=squares))
+
+
+def kernels(backend: Any = "core") -> Any:
+    """The numeric kernels the diagnosis calls: ``"core"`` (or ``None``) for
+    :mod:`lugre._native`, the compiled core; any other object is taken as the kernels
+    themselves, a module or object offering ``InverseRecord``, ``simulate``,
+    ``position_sums`` and ``irls_linear_grid`` with :mod:`lugre._native`'s signatures
+    (the NumPy twins: :mod:`lugre.reference.kernels`)."""
+    if backend is None or (isinstance(backend, str) and backend == "core"):
+        from .. import _native
+
+        return _native
+    if isinstance(backend, str) or not hasattr(backend, "InverseRecord"):
+        raise InputError.at("backend", f"unknown backend {backend!r}: use \"core\" or give "
+                            "the kernels (a module such as lugre.reference.kernels)")
+    return backend

@@ -74,7 +74,7 @@ def surrogates(rec: Recording, model: Model, sig: R.Signals
     if white > 0.0:
         ex = ex + np.sqrt(white * 0.5 * fs) * rng.standard_normal(x.size)
     ef = np.sqrt(sf * 0.5 * fs) * rng.standard_normal(x.size)
-    backend = "reference" if sig.backend.__name__.endswith("reference") else "core"
+    backend = sig.backend  # the kernels the record was prepared with
     out = []
     for sgn in (1.0, -1.0):
         r = Recording(t=rec.t, x=x + sgn * ex, F=force + sgn * ef)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from .exceptions import InputError
+from ..exceptions import InputError
 
 __all__ = ["Weighting", "median", "robust_scale", "t_quantile_975"]
 

@@ -8,102 +8,28 @@ medians of the robust scale are the same order statistics; the small linear solv
 the core's Gaussian elimination over Python floats. Exported by :mod:`lugre.reference`
 as :func:`irls_linear` and :func:`irls_linear_grid`.
 
-The argument conversions in front of both backends (:func:`design_matrix`,
-:func:`linear_args`, :func:`grid_args`, :func:`fit_result`) live here too, so
-that ``lugre._native`` refuses what this module refuses with the same message.
+The argument conversions in front of both backends are :mod:`lugre._args`'s, so that
+``lugre._native`` refuses what this module refuses with the same message.
 """
 
 from __future__ import annotations
 
 import math
-from numbers import Integral
 from typing import Any
 
 import numpy as np
 
-from ._reference_robust import Weighting
-from ._result import GridFit, LinearFit
-from .exceptions import DataError, InputError, ParameterError, _fmt_f64
+from .._args import grid_args, linear_args
+from .._result import GridFit, LinearFit
+from ..exceptions import DataError, InputError, ParameterError, _fmt_f64
+from .robust import Weighting
 
-__all__ = ["DEFAULT_ROUNDS", "candidate_matrices", "design_matrix", "fit_result", "grid_args",
-           "irls_linear", "irls_linear_grid", "linear_args", "round_count"]
+__all__ = ["DEFAULT_ROUNDS", "irls_linear", "irls_linear_grid"]
 
 #: Rounds of reweighting by default (``DEFAULT_ROUNDS`` in linear.rs).
 DEFAULT_ROUNDS = 8
 _RIDGE = 1e-12
 _SCALE_FLOOR = 1e-12
-
-
-# --------------------------------------------------------------------------------------
-# Conversions shared by both backends
-# --------------------------------------------------------------------------------------
-
-
-def design_matrix(name: str, x: Any) -> np.ndarray:
-    """``x`` as a 2-D float64 array (rows x columns), or InputError naming it."""
-    from .reference import _array
-
-    return _array(name, x, ndim=2)
-
-
-def candidate_matrices(extras: Any) -> list[np.ndarray]:
-    """The candidates' extra columns: a sequence of 2-D arrays (or one 3-D array)."""
-    if isinstance(extras, (str, bytes)) or not hasattr(extras, "__iter__"):
-        raise InputError.at("extras", "must be a sequence of 2-D arrays, one per candidate")
-    return [design_matrix(f"extras[{k}]", e) for k, e in enumerate(extras)]
-
-
-def round_count(rounds: Any) -> int:
-    """``rounds``: a whole number of at least 1."""
-    if isinstance(rounds, bool) or not isinstance(rounds, Integral):
-        raise TypeError(f"rounds must be an integer, got {type(rounds).__name__}")
-    if rounds < 1:
-        raise ParameterError.invalid("rounds", float(rounds),
-                                     "must be at least 1 (rounds of reweighting)")
-    return int(rounds)
-
-
-def weighting_name(weighting: Any) -> str:
-    if not isinstance(weighting, str):
-        raise TypeError(f"weighting must be a str, got {type(weighting).__name__}")
-    return weighting
-
-
-def ratio_value(ratio: Any) -> float:
-    try:
-        return float(ratio)
-    except (TypeError, ValueError):
-        raise ParameterError.invalid("ratio", ratio, "must be a finite number") from None
-
-
-def linear_args(x: Any, y: Any, weighting: Any, rounds: Any
-                ) -> tuple[np.ndarray, np.ndarray, str, int]:
-    """The arguments of ``irls_linear`` converted as both backends take them: ``X`` 2-D
-    and ``y`` 1-D float64, the weighting's name, the rounds (at least 1)."""
-    from .reference import _array
-
-    name = weighting_name(weighting)
-    nr = round_count(rounds)
-    return design_matrix("X", x), _array("y", y), name, nr
-
-
-def grid_args(x: Any, extras: Any, y: Any, weighting: Any, rounds: Any, ratio: Any
-              ) -> tuple[np.ndarray, list[np.ndarray], np.ndarray, str, int, float]:
-    """The arguments of ``irls_linear_grid`` converted as both backends take them."""
-    from .reference import _array
-
-    name = weighting_name(weighting)
-    nr = round_count(rounds)
-    rt = ratio_value(ratio)
-    xa = design_matrix("X", x)
-    cands = candidate_matrices(extras)
-    return xa, cands, _array("y", y), name, nr, rt
-
-
-def fit_result(f: Any) -> LinearFit:
-    """A :class:`LinearFit` from the core's ``_core.LinearFitResult``."""
-    return LinearFit(coef=f.coef, weights=f.weights, residuals=f.residuals, sse=f.sse,
-                     scale=f.scale)
 
 
 # --------------------------------------------------------------------------------------

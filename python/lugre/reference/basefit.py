@@ -10,9 +10,9 @@ from typing import Any
 
 import numpy as np
 
-from ._reference_robust import Weighting, robust_scale
-from .exceptions import DataError, InputError
-from .model import Model, _as_model
+from ..exceptions import DataError, InputError
+from ..model import Model, _as_model
+from .robust import Weighting, robust_scale
 
 __all__ = ["fit_base"]
 

@@ -22,20 +22,25 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ._reference_nm import NmOptions, minimize
-from ._reference_robust import Weighting, robust_scale
-from ._reference_static import _div, _usize
-from .exceptions import (
+from .._args import as_array as _array
+from .._entry import table_or_same
+from .._fits import DynamicFit, StaticFit
+from ..exceptions import (
     DataError,
     InputError,
     LugreError,
     ModelError,
     ParameterError,
 )
-from .identify import DynamicFit, StaticFit, _dynamic_fit
-from .io import Recording
-from .model import Model, ModelLike, _Parsed
-from .reference import _array, _check_finite, _check_time, _parsed, _simulate
+from ..identify import _dynamic_fit
+from ..io import Recording
+from ..model import Model, ModelLike, _Parsed
+from .checks import _check_finite, _check_time, _parsed
+from .nm import NmOptions, minimize
+from .robust import Weighting, robust_scale
+from .servo import _simulate
+from .static import _usize
+from .static_vp import _div
 
 __all__ = ["DynamicFit", "fit_dynamic"]
 
@@ -239,31 +244,8 @@ def _fit_record(m: _Parsed, t: list[float], x_ref: list[float], x_meas: list[flo
     """The core's ``fit_dynamic`` with default options but those given; the binding's
     result."""
     tol, max_evals, s2_rel = 1e-3, 200, 0.01
-    _check_time("t", t)
-    for name, a in (("x_ref", x_ref), ("x_measured", x_meas)):
-        if len(a) != len(t):
-            raise InputError.at(name, f"has {len(a)} samples but t has {len(t)}: give "
-                                "arrays of the same length")
-    _check_finite("x_ref", x_ref)
-    _check_finite("x_measured", x_meas)
-    for name, v in (("c1", c1), ("c2", c2), ("scale_floor", scale_floor),
-                    ("sigma2_rel_uncertainty", s2_rel)):
-        if not (math.isfinite(v) and v >= 0.0):
-            raise ParameterError.invalid(name, v, "must be finite and zero or greater")
-    if c1 == 0.0 and c2 == 0.0:
-        raise ParameterError.invalid("c1", 0.0, "c1 and c2 cannot both be zero")
-    for name, x in (("sigma0_start", sigma0_start), ("sigma1_start", sigma1_start)):
-        if x is not None and not (math.isfinite(x) and x > 0.0):
-            raise ParameterError.invalid(name, x, "must be a finite number greater than zero")
-    if m.controller is None or m.controller.law != "pid":
-        raise ModelError.at("controller", 'fit_dynamic needs a "pid" position controller '
-                            "(the loop of the record)")
-    if len(t) < 10:
-        raise DataError(f"data: {len(t)} samples: a dynamic fit needs a record of many "
-                        "control periods")
-    if max(x_meas) - min(x_meas) <= 0.0:
-        raise DataError("data: x_measured is constant: record a motion (a slow ramp that "
-                        "sticks and slips)")
+    _check_record(m, t, x_ref, x_meas, c1, c2, scale_floor, s2_rel, sigma0_start,
+                  sigma1_start)
     ta = np.array(t, dtype=np.float64)
     xra = np.array(x_ref, dtype=np.float64)
 
@@ -349,8 +331,50 @@ def _fit_record(m: _Parsed, t: list[float], x_ref: list[float], x_meas: list[flo
     th = out["theta"]
     s0, s1 = _exp(th[0]), _exp(th[1])
 
+    jac, probes = _final_jacobian(resid, th, reuse_jac)
+    evaluations += probes
+    e, w, unc = _intervals(out["residuals"], out["weights"], jac, s0, s1)
+    return _verdicts(m, out, e, w, unc, s2_rel, objective(e, w), evaluations)
+
+
+def _check_record(m: _Parsed, t: list[float], x_ref: list[float], x_meas: list[float],
+                  c1: float, c2: float, scale_floor: float, s2_rel: float,
+                  sigma0_start: float | None, sigma1_start: float | None) -> None:
+    """The core's checks of a dynamic fit's inputs, in its order."""
+    _check_time("t", t)
+    for name, a in (("x_ref", x_ref), ("x_measured", x_meas)):
+        if len(a) != len(t):
+            raise InputError.at(name, f"has {len(a)} samples but t has {len(t)}: give "
+                                "arrays of the same length")
+    _check_finite("x_ref", x_ref)
+    _check_finite("x_measured", x_meas)
+    for name, v in (("c1", c1), ("c2", c2), ("scale_floor", scale_floor),
+                    ("sigma2_rel_uncertainty", s2_rel)):
+        if not (math.isfinite(v) and v >= 0.0):
+            raise ParameterError.invalid(name, v, "must be finite and zero or greater")
+    if c1 == 0.0 and c2 == 0.0:
+        raise ParameterError.invalid("c1", 0.0, "c1 and c2 cannot both be zero")
+    for name, x in (("sigma0_start", sigma0_start), ("sigma1_start", sigma1_start)):
+        if x is not None and not (math.isfinite(x) and x > 0.0):
+            raise ParameterError.invalid(name, x, "must be a finite number greater than zero")
+    if m.controller is None or m.controller.law != "pid":
+        raise ModelError.at("controller", 'fit_dynamic needs a "pid" position controller '
+                            "(the loop of the record)")
+    if len(t) < 10:
+        raise DataError(f"data: {len(t)} samples: a dynamic fit needs a record of many "
+                        "control periods")
+    if max(x_meas) - min(x_meas) <= 0.0:
+        raise DataError("data: x_measured is constant: record a motion (a slow ramp that "
+                        "sticks and slips)")
+
+
+def _final_jacobian(resid: Resid, th: list[float], reuse_jac: Any
+                    ) -> tuple[list[list[float]] | None, int]:
+    """The residuals' Jacobian at the estimate (central differences, or the local
+    metric's when it was taken close enough) and the simulations it took."""
     h = 1e-3
     jac = None
+    evaluations = 0
     if reuse_jac is not None and max(abs(reuse_jac[0][0] - th[0]),
                                      abs(reuse_jac[0][1] - th[1])) <= h:
         jac = reuse_jac[1]
@@ -358,12 +382,18 @@ def _fit_record(m: _Parsed, t: list[float], x_ref: list[float], x_meas: list[flo
         probes = [[th[0] + h, th[1]], [th[0] - h, th[1]], [th[0], th[1] + h],
                   [th[0], th[1] - h]]
         sims = [resid(p) for p in probes]
-        evaluations += 4
+        evaluations = 4
         if all(x is not None for x in sims):
             a, b, c, d = sims
             jac = [[(p - q) / (2.0 * h) for p, q in zip(a, b)],
                    [(p - q) / (2.0 * h) for p, q in zip(c, d)]]
-    w, e = out["weights"], out["residuals"]
+    return jac, evaluations
+
+
+def _intervals(e: list[float], w: list[float], jac: list[list[float]] | None, s0: float,
+               s1: float) -> tuple[list[float], list[float], dict[str, Any]]:
+    """Standard errors and 95 % intervals of sigma0 and sigma1 from the Jacobian, widened
+    for the residuals' serial correlation; what the record determines."""
     n_used = sum(1 for x in w if x > 0.0)
     notes: list[str] = []
     std_err = [math.nan, math.nan]
@@ -411,6 +441,20 @@ def _fit_record(m: _Parsed, t: list[float], x_ref: list[float], x_meas: list[flo
         singular = True
         notes.append("the simulation failed next to the estimate: no intervals")
     identifiable = [not singular and math.isfinite(r) and r <= 0.5 for r in rel]
+    return e, w, {"std_err": std_err, "ci_low": ci_low, "ci_high": ci_high, "rel": rel,
+                  "correlation": correlation, "rho": rho, "inflation": inflation,
+                  "singular": singular, "identifiable": identifiable, "notes": notes}
+
+
+def _verdicts(m: _Parsed, out: dict[str, Any], e: list[float], w: list[float],
+              unc: dict[str, Any], s2_rel: float, objective: float, evaluations: int
+              ) -> DynamicFitResult:
+    """The plain-language notes and the binding's result."""
+    th = out["theta"]
+    s0, s1 = _exp(th[0]), _exp(th[1])
+    notes = unc["notes"]
+    rel, identifiable, singular = unc["rel"], unc["identifiable"], unc["singular"]
+    rho, inflation, correlation = unc["rho"], unc["inflation"], unc["correlation"]
     if singular:
         notes.append("the objective is flat in at least one direction (near-singular "
                      "Hessian): sigma0 and sigma1 cannot be separated by this record")
@@ -459,13 +503,13 @@ def _fit_record(m: _Parsed, t: list[float], x_ref: list[float], x_meas: list[flo
         if wi > 0.0:
             max_error = max(max_error, abs(ei))
     return DynamicFitResult(
-        sigma0=s0, sigma1=s1, std_err=std_err, ci_low=ci_low,
-        ci_high=ci_high, rel_ci_half_width=rel, identifiable=identifiable,
+        sigma0=s0, sigma1=s1, std_err=unc["std_err"], ci_low=unc["ci_low"],
+        ci_high=unc["ci_high"], rel_ci_half_width=rel, identifiable=identifiable,
         correlation=correlation, residual_autocorrelation=rho, notes=notes,
         residuals=np.array(e, dtype=np.float64),
         weights=np.array(w, dtype=np.float64),
         rms_error=math.sqrt(ssq / wsum) if wsum > 0.0 else math.nan,
-        max_error=max_error, objective=objective(e, w), scale=out["scale"],
+        max_error=max_error, objective=objective, scale=out["scale"],
         iterations=out["iterations"], evaluations=evaluations,
         converged=out["converged"],
     )
@@ -502,13 +546,11 @@ def fit_dynamic(recording: Recording | str, model: ModelLike, *, weighting: str 
 
     ``recording`` may also be a table with named columns, as for the facade.
     """
-    from . import _table_or_same
-
     def twin(mm: Model, rec: Recording, s0: float | None, s1: float | None,
              use_grid: bool) -> DynamicFitResult:
         return _record_call(mm, rec, weighting, c1, c2, s0, s1, use_grid, max_iter,
                             scale_floor, substeps, integrator)
 
-    return _dynamic_fit(twin, _table_or_same(recording), model, sigma0_start=sigma0_start,
+    return _dynamic_fit(twin, table_or_same(recording), model, sigma0_start=sigma0_start,
                         sigma1_start=sigma1_start, grid=grid, columns=columns,
                         static_fit=static_fit, static_draws=static_draws)

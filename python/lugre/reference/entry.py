@@ -1,5 +1,5 @@
-""":func:`diagnose` and :func:`fit_inverse_dynamics` on the NumPy twin of the
-inverse-dynamics kernel.
+""":func:`diagnose`, :func:`evaluate`, :func:`fit_inverse_dynamics` and :func:`fit_model` on
+the NumPy twin of the inverse-dynamics kernel.
 
 The diagnosis's orchestration (preparation, search, refit, evidence, wording) is shared
 with :func:`lugre.diagnose`; every numeric kernel it calls comes from the reference:
@@ -13,7 +13,10 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["diagnose", "fit_inverse_dynamics", "fit_model"]
+from .. import _entry
+from . import kernels
+
+__all__ = ["diagnose", "evaluate", "fit_inverse_dynamics", "fit_model"]
 
 
 def diagnose(recording: Any, model: Any, **kwargs: Any) -> Any:
@@ -27,16 +30,15 @@ def diagnose(recording: Any, model: Any, **kwargs: Any) -> Any:
     model : Model, dict or path
         The model believed to describe the axis.
     **kwargs
-        As :func:`lugre.diagnosis.diagnose` (``backend`` is fixed to ``"reference"``).
+        As :func:`lugre.diagnosis.diagnose` (``backend`` is fixed to
+        :mod:`lugre.reference.kernels`).
 
     Returns
     -------
     Diagnosis
     """
-    from . import diagnose as _diagnose
-
-    kwargs["backend"] = "reference"
-    return _diagnose(recording, model, **kwargs)
+    kwargs["backend"] = kernels
+    return _entry.diagnose(recording, model, **kwargs)
 
 
 def fit_inverse_dynamics(recording: Any, *args: Any, **kwargs: Any) -> Any:
@@ -48,16 +50,14 @@ def fit_inverse_dynamics(recording: Any, *args: Any, **kwargs: Any) -> Any:
         With motion in both directions.
     *args, **kwargs
         As :func:`lugre.diagnosis.fit_inverse_dynamics` (``backend`` fixed to
-        ``"reference"``).
+        :mod:`lugre.reference.kernels`).
 
     Returns
     -------
     Model
     """
-    from . import fit_inverse_dynamics as _fit
-
-    kwargs["backend"] = "reference"
-    return _fit(recording, *args, **kwargs)
+    kwargs["backend"] = kernels
+    return _entry.fit_inverse_dynamics(recording, *args, **kwargs)
 
 
 def fit_model(recording: Any, **kwargs: Any) -> Any:
@@ -69,14 +69,35 @@ def fit_model(recording: Any, **kwargs: Any) -> Any:
     recording : Recording, path or table with named columns
         With motion in both directions.
     **kwargs
-        As :func:`lugre.diagnosis.fit_model` (``backend`` fixed to ``"reference"``).
+        As :func:`lugre.diagnosis.fit_model` (``backend`` fixed to
+        :mod:`lugre.reference.kernels`).
 
     Returns
     -------
     tuple
         ``(model, fit)``.
     """
-    from . import fit_model as _fit
+    kwargs["backend"] = kernels
+    return _entry.fit_model(recording, **kwargs)
 
-    kwargs["backend"] = "reference"
-    return _fit(recording, **kwargs)
+
+def evaluate(recording: Any, model: Any, *, cutoff_hz: float | None = None) -> dict[str, Any]:
+    """The inverse-dynamics force residual of ``model`` on ``recording``, on the NumPy
+    kernel: twin of :func:`lugre.evaluate` (same parameters, result and errors).
+
+    Parameters
+    ----------
+    recording : Recording, path or table with named columns
+        The recording.
+    model : Model, dict or path
+        The model (its effects included).
+    cutoff_hz : float, optional
+        Low-pass cut-off (default ``fs/25``).
+
+    Returns
+    -------
+    dict
+        ``rms_force`` [N], ``nrmse_force``, ``noise_floor`` [N], ``samples``,
+        ``cutoff_hz``.
+    """
+    return _entry.evaluate(recording, model, cutoff_hz=cutoff_hz, backend=kernels)

@@ -11,24 +11,21 @@ and the exact sensitivities of the LuGre force to its parameters. Exported as
 from __future__ import annotations
 
 import math
-from numbers import Integral
 from typing import Any
 
 import numpy as np
 
-from .exceptions import InputError, ParameterError, _fmt_f64
-from .model import ModelLike, _as_model
+from .._args import as_array as _array
+from .._args import frequency_count
+from ..exceptions import InputError, ParameterError, _fmt_f64
+from ..model import ModelLike, _as_model
 
-__all__ = ["COUPLING_SUBSTEPS", "MAX_FREQUENCIES", "InverseRecord", "parse_base_param",
+__all__ = ["COUPLING_SUBSTEPS", "InverseRecord", "parse_base_param",
            "position_sums"]
 
 #: Substeps multiplier of the load simulation behind a ``resonance``
 #: (``COUPLING_SUBSTEPS`` in src/inverse/mod.rs).
 COUPLING_SUBSTEPS = 2
-
-#: Most frequencies in one call of :func:`position_sums` (``MAX_FREQUENCIES`` in
-#: ``src/inverse/spectrum.rs``).
-MAX_FREQUENCIES = 1 << 26
 
 _SIDES = ("positive", "negative")
 _KEYS = ("fc", "fs", "sigma2", "vs")
@@ -318,7 +315,7 @@ class InverseRecord:
 
     def coupling_force(self, model: ModelLike) -> np.ndarray:
         """Unfiltered force the ``resonance`` coupling passes to the load."""
-        from .reference import load_coupling
+        from .coupling import load_coupling
 
         m = _as_model(model)
         return load_coupling(self.x_drive, self.v, self.dt, m, scale=self.friction_scale(m),
@@ -386,7 +383,7 @@ class InverseRecord:
         ``fit_base``; see ``lugre._reference_basefit``)."""
         import warnings
 
-        from ._reference_basefit import fit_base
+        from .basefit import fit_base
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -467,17 +464,6 @@ class InverseRecord:
         return force, jac, nonzero
 
 
-def frequency_count(n: Any) -> int:
-    """The ``n`` of :func:`position_sums`: an integer from 1 to :data:`MAX_FREQUENCIES`,
-    else ParameterError (the same check in front of both backends)."""
-    if isinstance(n, bool) or not isinstance(n, Integral):
-        raise ParameterError.invalid("n", n, "must be a whole number of frequencies")
-    if not 1 <= int(n) <= MAX_FREQUENCIES:
-        raise ParameterError.invalid("n", float(n), f"must be between 1 and {MAX_FREQUENCIES} "
-                                     "frequencies")
-    return int(n)
-
-
 def _number(name: str, value: Any) -> float:
     try:
         return float(value)
@@ -524,8 +510,6 @@ def position_sums(x: Any, r: Any, k0: float, dk: float, n: int, *, squares: bool
     ParameterError
         ``k0`` not finite, ``dk`` not finite or <= 0, ``n`` out of range.
     """
-    from .reference import _array
-
     xa, ra = _array("x", x), _array("r", r)
     k0f, dkf = _number("k0", k0), _number("dk", dk)
     nn = frequency_count(n)

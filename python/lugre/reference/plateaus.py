@@ -21,11 +21,14 @@ from typing import Any
 
 import numpy as np
 
-from ._reference_static import _div, _usize
-from .exceptions import DataError, InputError, ParameterError
-from .identify import SteadyStatePoints, _steady_state_points
-from .io import Recording
-from .reference import _check_finite, _check_len, _check_time
+from .._entry import table_or_same
+from .._fits import SteadyStatePoints
+from ..exceptions import DataError, InputError, ParameterError
+from ..identify import _steady_state_points
+from ..io import Recording
+from .checks import _check_finite, _check_len, _check_time
+from .static import _usize
+from .static_vp import _div
 
 __all__ = ["PlateauResult", "SteadyStatePoints", "plateaus", "steady_state_points"]
 
@@ -293,9 +296,7 @@ def steady_state_points(recording: Recording | str, force_constant: float | None
     -------
     SteadyStatePoints
     """
-    from . import _table_or_same
-
-    return _steady_state_points(plateaus, _table_or_same(recording), force_constant,
+    return _steady_state_points(plateaus, table_or_same(recording), force_constant,
                                 columns=columns, settle_fraction=settle_fraction,
                                 velocity_tolerance=velocity_tolerance, chunks=chunks,
                                 min_samples=min_samples)
