@@ -10,13 +10,13 @@ from __future__ import annotations
 import json
 import os
 import warnings
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
 from ._native import simulate, stribeck
 from .exceptions import ConvergenceWarning
-from .identify import StaticFit, fit_dynamic, fit_static
+from .identify import DynamicFit, StaticFit, fit_dynamic, fit_static
 from .io import Recording
 from .model import Model
 from .plots import figure, label_axes, save_png, static_fit_figure
@@ -151,7 +151,28 @@ def run_paper(out_dir: str | os.PathLike[str], *, seed: int = 1, monte_carlo: in
     for k, v in CHOICES.items():
         say(f"  {k}: {v}")
 
-    # ---- Table 1: static parameters --------------------------------------------------
+    igg = _table1(rng, truth, out_dir, say, result)
+    if monte_carlo:
+        result["monte_carlo"] = _monte_carlo(rng, truth, monte_carlo, say)
+    dyn = _table2(truth, igg, seed, out_dir, say, result)
+    _tracking(truth, dyn, out_dir, say, result)
+    say(f"\nfigures: {out_dir}/paper_static_fit.png, paper_dynamic_fit.png, "
+        "paper_speed_tracking.png")
+    # what is written is what is returned (plain JSON types)
+    result = json.loads(json.dumps(result, default=_plain))
+    path = os.path.join(out_dir, "paper.json")
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        json.dump(result, f, indent=1)
+    os.replace(tmp, path)
+    say(f"numbers: {path}")
+    return result
+
+
+def _table1(rng: np.random.Generator, truth: Model, out_dir: str | os.PathLike[str],
+            say: Callable[..., None], result: dict[str, Any]) -> StaticFit:
+    """Table 1, the static parameters: the IGG fit (returned) and least squares on one
+    data set with gross errors, and its figure."""
     v, F, outlier = static_dataset(rng)
     igg = fit_static(v, F, weighting="igg")
     ls = fit_static(v, F, weighting="none")
@@ -178,30 +199,39 @@ def run_paper(out_dir: str | os.PathLike[str], *, seed: int = 1, monte_carlo: in
     result["worst_static_error"] = {"igg": _worst_error(igg, truth),
                                     "ls": _worst_error(ls, truth)}
     static_fit_figure(v, F, igg, os.path.join(out_dir, "paper_static_fit.png"))
+    return igg
 
-    if monte_carlo:
-        mc: dict[str, list[float]] = {w: [] for w in ("igg", "huber", "tukey", "none")}
-        unsettled = 0
-        for _ in range(monte_carlo):
-            vv, FF, _ = static_dataset(rng)
-            for w, errs in mc.items():
-                with warnings.catch_warnings(record=True) as seen:
-                    warnings.simplefilter("always", ConvergenceWarning)
-                    errs.append(_worst_error(fit_static(vv, FF, weighting=w), truth))
-                unsettled += len(seen)
-        say(f"\n  Monte Carlo over {monte_carlo} such datasets, worst parameter's relative "
-            "error:")
-        summary = {}
-        for w, e in mc.items():
-            med, p95 = np.median(e), np.percentile(e, 95)
-            summary[w] = (float(med), float(p95))
-            name = "least squares" if w == "none" else w.upper() if w == "igg" else w
-            say(f"    {name:14s} median {100 * med:5.2f} %   95th percentile {100 * p95:6.2f} %")
-        if unsettled:
-            say(f"    ({unsettled} of {4 * monte_carlo} fits ended at the IRLS iteration limit)")
-        result["monte_carlo"] = summary
 
-    # ---- Table 2: dynamic parameters -------------------------------------------------
+def _monte_carlo(rng: np.random.Generator, truth: Model, monte_carlo: int,
+                 say: Callable[..., None]) -> dict[str, tuple[float, float]]:
+    """The worst parameter's relative error of each weighting over ``monte_carlo`` static
+    data sets: its median and 95th percentile."""
+    mc: dict[str, list[float]] = {w: [] for w in ("igg", "huber", "tukey", "none")}
+    unsettled = 0
+    for _ in range(monte_carlo):
+        vv, FF, _ = static_dataset(rng)
+        for w, errs in mc.items():
+            with warnings.catch_warnings(record=True) as seen:
+                warnings.simplefilter("always", ConvergenceWarning)
+                errs.append(_worst_error(fit_static(vv, FF, weighting=w), truth))
+            unsettled += len(seen)
+    say(f"\n  Monte Carlo over {monte_carlo} such datasets, worst parameter's relative "
+        "error:")
+    summary = {}
+    for w, e in mc.items():
+        med, p95 = np.median(e), np.percentile(e, 95)
+        summary[w] = (float(med), float(p95))
+        name = "least squares" if w == "none" else w.upper() if w == "igg" else w
+        say(f"    {name:14s} median {100 * med:5.2f} %   95th percentile {100 * p95:6.2f} %")
+    if unsettled:
+        say(f"    ({unsettled} of {4 * monte_carlo} fits ended at the IRLS iteration limit)")
+    return summary
+
+
+def _table2(truth: Model, igg: StaticFit, seed: int, out_dir: str | os.PathLike[str],
+            say: Callable[..., None], result: dict[str, Any]) -> DynamicFit:
+    """Table 2, the dynamic parameters: the stick-slip fit (returned) with the static
+    sets of Table 1, the presliding record that determines sigma1, and the figure."""
     d = truth.to_dict()
     d["controller"] = {"type": "pid", "kp": 2e4, "ki": 2e4, "kd": 0.0, "rate_hz": 1e4}
     plant = Model.from_dict(d)
@@ -286,8 +316,13 @@ def run_paper(out_dir: str | os.PathLike[str], *, seed: int = 1, monte_carlo: in
     label_axes(ax, ["x [mm]", "residual [um]"], "t [s]")
     ax[0].set_title("Stick-slip record and the identified model (eq. 18 fit)")
     save_png(fig, os.path.join(out_dir, "paper_dynamic_fit.png"))
+    return dyn
 
-    # ---- speed tracking ----------------------------------------------------------------
+
+def _tracking(truth: Model, dyn: DynamicFit, out_dir: str | os.PathLike[str],
+              say: Callable[..., None], result: dict[str, Any]) -> None:
+    """The speed tracking test without and with the identified friction feed-forward,
+    and its figure."""
     t = np.arange(0.0, 2.0, 1e-4)
     v_d = np.sin(2 * np.pi * t)
     base = truth.to_dict()
@@ -312,17 +347,6 @@ def run_paper(out_dir: str | os.PathLike[str], *, seed: int = 1, monte_carlo: in
     label_axes(ax, ["speed error [cm/s]"], "t [s]")
     ax[0].set_title("Speed tracking error (paper Figs. 1 and 2)")
     save_png(fig, os.path.join(out_dir, "paper_speed_tracking.png"))
-    say(f"\nfigures: {out_dir}/paper_static_fit.png, paper_dynamic_fit.png, "
-        "paper_speed_tracking.png")
-    # what is written is what is returned (plain JSON types)
-    result = json.loads(json.dumps(result, default=_plain))
-    path = os.path.join(out_dir, "paper.json")
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        json.dump(result, f, indent=1)
-    os.replace(tmp, path)
-    say(f"numbers: {path}")
-    return result
 
 
 def _plain(o: Any) -> Any:

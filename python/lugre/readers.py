@@ -22,7 +22,7 @@ import json
 import math
 import os
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -263,9 +263,6 @@ def read_recording(path: str | os.PathLike[str], columns: ColumnSpec = None, *,
         def get(name: str) -> np.ndarray:
             return arrays[name]
 
-        def row_of(k: int) -> int:
-            return k
-
         vectors = [a.size for a in arrays.values() if a.ndim == 1]
         n_rows = max(vectors) if vectors else 0
 
@@ -311,10 +308,28 @@ def read_recording(path: str | os.PathLike[str], columns: ColumnSpec = None, *,
             origin["t"] = dt_name
             meta = {**meta, "t": f"built as {dt_name}*arange(n), {dt_name} = {dt!r} s"}
 
-    if csv:
-        vector_names = names
-    else:
-        vector_names = [k for k in names if arrays[k].ndim == 1]
+    vector_names = names if csv else [k for k in names if arrays[k].ndim == 1]
+    _check_found(p, found, origin, names, vector_names, row_of if csv else None)
+    scale = X_UNITS[x_unit]
+    if scale != 1.0:
+        for c in ("x", "x_ref", "v", "v_ref"):
+            if c in found:
+                found[c] = found[c] * scale
+        meta = {**meta, "x_unit": f"positions and speeds read in {x_unit}, converted to m"}
+    return Recording(**found, meta=meta, source=p)
+
+
+def _check_found(p: str, found: dict[str, np.ndarray], origin: dict[str, str],
+                 names: list[str], vector_names: list[str],
+                 row_of: Callable[[int], int] | None) -> None:
+    """The columns a recording needs, as vectors of one length, finite, within
+    :data:`MAX_MAGNITUDE` (the measured ones) and ``t`` strictly increasing; else
+    FileFormatError naming the place (``row_of``: a sample's line in a CSV file, None
+    for arrays)."""
+
+    def line(k: int) -> int:
+        return row_of(k) if row_of else k
+
     for want in ("t", "x"):
         if want not in found:
             raise _missing(p, want, names, None, vector_names)
@@ -347,38 +362,31 @@ def read_recording(path: str | os.PathLike[str], columns: ColumnSpec = None, *,
         bad = np.flatnonzero(~np.isfinite(a))
         if bad.size:
             k = int(bad[0])
-            where = f"line {row_of(k)}" if csv else f"sample {k}"
+            where = f"line {row_of(k)}" if row_of else f"sample {k}"
             raise FileFormatError(
                 f"{p}, {where}, column {origin[c]!r}: value {a[k]} is not finite: remove "
                 "or interpolate the sample",
-                path=p, row=row_of(k), column=origin[c],
+                path=p, row=line(k), column=origin[c],
             )
         big = np.flatnonzero(np.abs(a) > MAX_MAGNITUDE) if c in _MEASURED else ()
         if len(big):
             k = int(big[0])
-            where = f"line {row_of(k)}" if csv else f"sample {k}"
+            where = f"line {row_of(k)}" if row_of else f"sample {k}"
             raise FileFormatError(
                 f"{p}, {where}, column {origin[c]!r}: value {a[k]:.6g} is beyond any "
                 f"measurement (|value| > {MAX_MAGNITUDE:g}): fix or remove the sample",
-                path=p, row=row_of(k), column=origin[c],
+                path=p, row=line(k), column=origin[c],
             )
     t = found["t"]
     bad = np.flatnonzero(np.diff(t) <= 0.0)
     if bad.size:
         k = int(bad[0]) + 1
-        where = f"line {row_of(k)}" if csv else f"sample {k}"
+        where = f"line {row_of(k)}" if row_of else f"sample {k}"
         raise FileFormatError(
             f"{p}, {where}, column {origin['t']!r}: time is not strictly increasing "
             f"({t[k]!r} after {t[k - 1]!r}): sort the record and drop repeated samples",
-            path=p, row=row_of(k), column=origin["t"],
+            path=p, row=line(k), column=origin["t"],
         )
-    scale = X_UNITS[x_unit]
-    if scale != 1.0:
-        for c in ("x", "x_ref", "v", "v_ref"):
-            if c in found:
-                found[c] = found[c] * scale
-        meta = {**meta, "x_unit": f"positions and speeds read in {x_unit}, converted to m"}
-    return Recording(**found, meta=meta, source=p)
 
 
 def write_recording(path: Any, rec: Any) -> None:
