@@ -296,70 +296,33 @@ impl Paths<'_> {
         let out = o.weights.len() as f64 - kept;
         kept * (o.scale.max(self.scale_floor).ln() + half_ln_2pi_e) + out * width.ln()
     }
-}
 
-/// Fit one direction to magnitudes `a = |v|` and mirrored forces `y = sign(v)*F`.
-fn fit_direction(
-    a: &[f64],
-    y: &[f64],
-    sign: f64,
-    indices: Vec<usize>,
-    opts: &StaticFitOptions,
-    notes: &mut Vec<String>,
-    label: &str,
-) -> Result<DirectionFit> {
-    let fscale = median(&y.iter().map(|v| v.abs()).collect::<Vec<_>>()).max(1e-12);
-    let scale_floor = opts.scale_floor.max(1e-6 * fscale);
-    let cfg = Cfg {
-        max_outer: opts.max_iter,
-        tol: opts.tol,
-        scale_floor,
-        nm: NmOptions {
-            max_evals: opts.max_evals,
-            xtol: 1e-10,
-            ftol: 1e-12,
-            restarts: 0,
-        },
-        nm_loose: NmOptions {
-            max_evals: opts.max_evals,
-            xtol: 1e-10,
-            ftol: 1e-7,
-            restarts: 0,
-        },
-        nm_pre: NmOptions {
-            max_evals: opts.max_evals,
-            xtol: 1e-10,
-            ftol: 1e-5,
-            restarts: 0,
-        },
-        obj_floor: 1e-6 * scale_floor * scale_floor,
-    };
-    let reject_at = match opts.weighting {
-        Weighting::Igg { k1, .. } => Some(k1),
-        Weighting::Tukey { c } => Some(c),
-        _ => None,
-    };
-    let paths = Paths {
-        cfg: &cfg,
-        weighting: opts.weighting,
-        rejects: reject_at.is_some(),
-        refit_at: reject_at
-            .filter(|_| opts.refit_kept)
-            .map(|k1| k1.max(reweight::REFIT_REJECT_MIN)),
-        scale_floor,
-    };
-    let n = a.len();
-    let out = if n > opts.max_start_points {
-        // Many points (FAST-LTS, Rousseeuw and Van Driessen 2006): the starts and their
-        // paths on a subsample spread over the speeds; the best [`FINISHED_PATHS`]
-        // distinct ones (kept sets) once more on all points, each from its subsample
-        // answer at its kind of scale (the MAD, or held: the scale of all points there
-        // reweighted from the path's own, [`rescale`]), and of those the one of the
-        // smallest cost on all points.
-        let sub = subsample(a, opts.max_start_points);
+    /// The best path on all points, from starts on all of them.
+    fn best(&self, a: &[f64], y: &[f64], fscale: f64) -> Outcome {
+        let ranked = self.ranked(&mut Sep::new(a, y, fscale), fscale);
+        let evals = ranked.iter().map(|o| o.0.evals).sum();
+        let mut best = ranked.into_iter().next().expect("at least one path").0;
+        best.evals = evals;
+        best
+    }
+
+    /// The best path among many points (FAST-LTS, Rousseeuw and Van Driessen 2006): the
+    /// starts and their paths on a subsample spread over the speeds; the best
+    /// [`FINISHED_PATHS`] distinct ones (kept sets) once more on all points, each from
+    /// its subsample answer at its kind of scale (the MAD, or held: the scale of all
+    /// points there reweighted from the path's own, [`rescale`]), and of those the one
+    /// of the smallest cost on all points.
+    fn best_by_subsample(
+        &self,
+        a: &[f64],
+        y: &[f64],
+        fscale: f64,
+        max_start_points: usize,
+    ) -> Outcome {
+        let sub = subsample(a, max_start_points);
         let a_s: Vec<f64> = sub.iter().map(|&i| a[i]).collect();
         let y_s: Vec<f64> = sub.iter().map(|&i| y[i]).collect();
-        let ranked = paths.ranked(&mut Sep::new(&a_s, &y_s, fscale), fscale);
+        let ranked = self.ranked(&mut Sep::new(&a_s, &y_s, fscale), fscale);
         let mut evals: usize = ranked.iter().map(|o| o.0.evals).sum();
         let mut sep = Sep::new(a, y, fscale);
         let mut kept_sets: Vec<Vec<bool>> = Vec::new();
@@ -378,28 +341,87 @@ fn fit_direction(
                     (s.is_finite() && s > 0.0).then_some(s)
                 }
             };
-            let f = paths.run(&mut sep, p0, None, fixed);
+            let f = self.run(&mut sep, p0, None, fixed);
             evals += f.evals;
             finished.push(f);
             if finished.len() == FINISHED_PATHS {
                 break;
             }
         }
-        let width = paths.width(y);
+        let width = self.width(y);
         let mut best = finished
             .into_iter()
-            .map(|o| (paths.cost(&o, width), o))
+            .map(|o| (self.cost(&o, width), o))
             .min_by(|x, y| x.0.total_cmp(&y.0))
             .map(|x| x.1)
             .expect("at least one path");
         best.evals = evals;
         best
+    }
+}
+
+impl Cfg {
+    /// The settings of one direction's fit: the options' limits, the residual scale
+    /// floor `scale_floor` and three simplex tolerances.
+    fn new(opts: &StaticFitOptions, scale_floor: f64) -> Cfg {
+        Cfg {
+            max_outer: opts.max_iter,
+            tol: opts.tol,
+            scale_floor,
+            nm: NmOptions {
+                max_evals: opts.max_evals,
+                xtol: 1e-10,
+                ftol: 1e-12,
+                restarts: 0,
+            },
+            nm_loose: NmOptions {
+                max_evals: opts.max_evals,
+                xtol: 1e-10,
+                ftol: 1e-7,
+                restarts: 0,
+            },
+            nm_pre: NmOptions {
+                max_evals: opts.max_evals,
+                xtol: 1e-10,
+                ftol: 1e-5,
+                restarts: 0,
+            },
+            obj_floor: 1e-6 * scale_floor * scale_floor,
+        }
+    }
+}
+
+/// Fit one direction to magnitudes `a = |v|` and mirrored forces `y = sign(v)*F`.
+fn fit_direction(
+    a: &[f64],
+    y: &[f64],
+    sign: f64,
+    indices: Vec<usize>,
+    opts: &StaticFitOptions,
+    notes: &mut Vec<String>,
+    label: &str,
+) -> Result<DirectionFit> {
+    let fscale = median(&y.iter().map(|v| v.abs()).collect::<Vec<_>>()).max(1e-12);
+    let scale_floor = opts.scale_floor.max(1e-6 * fscale);
+    let cfg = Cfg::new(opts, scale_floor);
+    let reject_at = match opts.weighting {
+        Weighting::Igg { k1, .. } => Some(k1),
+        Weighting::Tukey { c } => Some(c),
+        _ => None,
+    };
+    let paths = Paths {
+        cfg: &cfg,
+        weighting: opts.weighting,
+        rejects: reject_at.is_some(),
+        refit_at: reject_at
+            .filter(|_| opts.refit_kept)
+            .map(|k1| k1.max(reweight::REFIT_REJECT_MIN)),
+        scale_floor,
+    };
+    let out = if a.len() > opts.max_start_points {
+        paths.best_by_subsample(a, y, fscale, opts.max_start_points)
     } else {
-        let ranked = paths.ranked(&mut Sep::new(a, y, fscale), fscale);
-        let evals = ranked.iter().map(|o| o.0.evals).sum();
-        let mut best = ranked.into_iter().next().expect("at least one path").0;
-        best.evals = evals;
-        best
+        paths.best(a, y, fscale)
     };
     if !out.p.iter().all(|v| v.is_finite()) {
         return Err(Error::Data(format!(

@@ -15,13 +15,16 @@
 //! determined, while `sigma1` acts only during the short transitions and is confounded
 //! with `sigma2` (the presliding damping is `sigma1 + sigma2`), so it is often not.
 
-use super::irls::{irls, IrlsSetup};
+mod uncertainty;
+
+use super::irls::{irls, IrlsOutcome, IrlsSetup};
 use super::nelder_mead::NmOptions;
 use super::robust::{robust_scale, Weighting};
 use crate::error::{check_finite, check_len, check_time, Error, Result};
 use crate::servo::{simulate, ControlLaw, Drive, Model, SimOptions};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
+use uncertainty::{lag_one_autocorrelation, notes, Intervals};
 
 /// Options of [`fit_dynamic`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -329,6 +332,13 @@ pub fn fit_dynamic_with(
     r
 }
 
+/// The position residuals `x_measured - x_sim` at `theta = (ln sigma0, ln sigma1)`,
+/// `None` where the loop cannot be simulated.
+type Resid<'a> = dyn Fn(&[f64]) -> Option<Vec<f64>> + Sync + 'a;
+
+/// A Jacobian of the simulated positions and the point where it was taken.
+type TakenJacobian = ([f64; 2], [Vec<f64>; 2]);
+
 fn fit_dynamic_body(
     model: &Model,
     t: &[f64],
@@ -337,6 +347,82 @@ fn fit_dynamic_body(
     opts: &DynamicFitOptions,
     cancel: &AtomicBool,
 ) -> Result<DynamicFit> {
+    check_record(model, t, x_ref, x_measured, opts)?;
+    let sim_opts = opts.sim;
+    // check the model runs at all (errors in the model or inputs surface here)
+    simulate(model, t, Drive::Position(x_ref), &sim_opts, &mut || true)?;
+
+    let resid = |th: &[f64]| -> Option<Vec<f64>> {
+        let (s0, s1) = (th[0].exp(), th[1].exp());
+        if cancel.load(Ordering::Relaxed) || !(s0.is_finite() && s1.is_finite() && s0 > 0.0) {
+            return None;
+        }
+        let m = with_sigmas(model, s0, s1);
+        let r = simulate(&m, t, Drive::Position(x_ref), &sim_opts, &mut || {
+            !cancel.load(Ordering::Relaxed)
+        })
+        .ok()?;
+        Some(x_measured.iter().zip(&r.x).map(|(a, b)| a - b).collect())
+    };
+    let (c1, c2) = (opts.c1, opts.c2);
+    let objective = move |e: &[f64], w: &[f64]| -> f64 { eq18(c1, c2, e, w) };
+
+    let mut evaluations = 0usize;
+    let start = start(&resid, model, t.len(), opts, &mut evaluations);
+    let (out, reuse_jac) = minimise(&resid, &objective, start, t.len(), opts, &mut evaluations)?;
+    evaluations += out.evals;
+    let th = out.theta.clone();
+    let (s0, s1) = (th[0].exp(), th[1].exp());
+    let jac = jacobian_at_estimate(&resid, &th, reuse_jac, &mut evaluations);
+    let w = &out.weights;
+    let e = &out.residuals;
+    let rho = lag_one_autocorrelation(e, w);
+    let inflation = (1.0 + rho) / (1.0 - rho);
+    let iv = Intervals::new(jac.as_ref(), e, w, inflation, [s0, s1]);
+    let notes = notes(model, opts, &out, &iv, [s0, s1], rho, inflation);
+    let wsum: f64 = w.iter().sum();
+    let ssq: f64 = e.iter().zip(w).map(|(ei, wi)| wi * ei * ei).sum();
+    let max_error = e
+        .iter()
+        .zip(w)
+        .filter(|(_, wi)| **wi > 0.0)
+        .fold(0.0f64, |m, (ei, _)| m.max(ei.abs()));
+    Ok(DynamicFit {
+        sigma0: s0,
+        sigma1: s1,
+        std_err: iv.std_err,
+        ci_low: iv.ci_low,
+        ci_high: iv.ci_high,
+        rel_ci_half_width: iv.rel,
+        identifiable: iv.identifiable,
+        correlation: iv.correlation,
+        residual_autocorrelation: rho,
+        notes,
+        objective: objective(e, w),
+        rms_error: if wsum > 0.0 {
+            (ssq / wsum).sqrt()
+        } else {
+            f64::NAN
+        },
+        max_error,
+        scale: out.scale,
+        residuals: out.residuals,
+        weights: out.weights,
+        iterations: out.iterations,
+        evaluations,
+        converged: out.converged,
+    })
+}
+
+/// Refuse a record [`fit_dynamic`] cannot use: lengths, non-finite values, no `pid`
+/// controller, too short, or no motion at all.
+fn check_record(
+    model: &Model,
+    t: &[f64],
+    x_ref: &[f64],
+    x_measured: &[f64],
+    opts: &DynamicFitOptions,
+) -> Result<()> {
     check_time("t", t)?;
     check_len("x_ref", x_ref, t.len(), "t")?;
     check_len("x_measured", x_measured, t.len(), "t")?;
@@ -366,68 +452,78 @@ fn fit_dynamic_body(
             "x_measured is constant: record a motion (a slow ramp that sticks and slips)".into(),
         ));
     }
-    let sim_opts = opts.sim;
-    // check the model runs at all (errors in the model or inputs surface here)
-    simulate(model, t, Drive::Position(x_ref), &sim_opts, &mut || true)?;
+    Ok(())
+}
 
-    let resid = |th: &[f64]| -> Option<Vec<f64>> {
-        let (s0, s1) = (th[0].exp(), th[1].exp());
-        if cancel.load(Ordering::Relaxed) || !(s0.is_finite() && s1.is_finite() && s0 > 0.0) {
-            return None;
-        }
-        let m = with_sigmas(model, s0, s1);
-        let r = simulate(&m, t, Drive::Position(x_ref), &sim_opts, &mut || {
-            !cancel.load(Ordering::Relaxed)
-        })
-        .ok()?;
-        Some(x_measured.iter().zip(&r.x).map(|(a, b)| a - b).collect())
-    };
-    let (c1, c2) = (opts.c1, opts.c2);
-    let objective = move |e: &[f64], w: &[f64]| -> f64 {
-        let mut ss = 0.0;
-        let mut mx = 0.0f64;
-        for (ei, wi) in e.iter().zip(w) {
-            ss += wi * ei * ei;
-            if *wi > 0.0 {
-                mx = mx.max(ei.abs());
-            }
-        }
-        c1 * ss + c2 * mx
-    };
-
-    let s0_start = opts.sigma0_start.unwrap_or(model.friction.sigma0);
-    let s1_start = opts.sigma1_start.unwrap_or(model.friction.sigma1).max(1e-6);
-    let mut theta0 = vec![s0_start.ln(), s1_start.ln()];
-    let mut evaluations = 0usize;
-    let ln10 = std::f64::consts::LN_10;
-    let mut step = vec![0.2, 0.5];
-    if opts.grid {
-        let mut nodes = Vec::new();
-        for i in 0..5 {
-            for j in 0..3 {
-                nodes.push([
-                    theta0[0] + ln10 * (i as f64 - 2.0) / 2.0,
-                    theta0[1] + ln10 * (j as f64 - 1.0),
-                ]);
-            }
-        }
-        let ones = vec![1.0; t.len()];
-        let scores: Vec<f64> = nodes
-            .par_iter()
-            .map(|th| match resid(th) {
-                Some(e) => objective(&e, &ones),
-                None => f64::INFINITY,
-            })
-            .collect();
-        evaluations += nodes.len();
-        if let Some(k) = (0..nodes.len())
-            .filter(|&k| scores[k].is_finite())
-            .min_by(|&a, &b| scores[a].total_cmp(&scores[b]))
-        {
-            theta0 = nodes[k].to_vec();
-            step = vec![ln10 / 4.0, ln10 / 2.0];
+/// The paper's eq. 18: `c1*sum(w*e^2) + c2*max|e|` over the points with `w > 0`.
+fn eq18(c1: f64, c2: f64, e: &[f64], w: &[f64]) -> f64 {
+    let mut ss = 0.0;
+    let mut mx = 0.0f64;
+    for (ei, wi) in e.iter().zip(w) {
+        ss += wi * ei * ei;
+        if *wi > 0.0 {
+            mx = mx.max(ei.abs());
         }
     }
+    c1 * ss + c2 * mx
+}
+
+/// The start `theta0` of the search and its simplex steps: the options' (or the
+/// model's) sigmas, or with `opts.grid` the best node of a coarse grid around them
+/// (5 x 3 decades apart by half and one, simulated in parallel).
+fn start(
+    resid: &Resid,
+    model: &Model,
+    n: usize,
+    opts: &DynamicFitOptions,
+    evaluations: &mut usize,
+) -> (Vec<f64>, Vec<f64>) {
+    let s0_start = opts.sigma0_start.unwrap_or(model.friction.sigma0);
+    let s1_start = opts.sigma1_start.unwrap_or(model.friction.sigma1).max(1e-6);
+    let theta0 = vec![s0_start.ln(), s1_start.ln()];
+    let step = vec![0.2, 0.5];
+    if !opts.grid {
+        return (theta0, step);
+    }
+    let ln10 = std::f64::consts::LN_10;
+    let mut nodes = Vec::new();
+    for i in 0..5 {
+        for j in 0..3 {
+            nodes.push([
+                theta0[0] + ln10 * (i as f64 - 2.0) / 2.0,
+                theta0[1] + ln10 * (j as f64 - 1.0),
+            ]);
+        }
+    }
+    let ones = vec![1.0; n];
+    let scores: Vec<f64> = nodes
+        .par_iter()
+        .map(|th| match resid(th) {
+            Some(e) => eq18(opts.c1, opts.c2, &e, &ones),
+            None => f64::INFINITY,
+        })
+        .collect();
+    *evaluations += nodes.len();
+    match (0..nodes.len())
+        .filter(|&k| scores[k].is_finite())
+        .min_by(|&a, &b| scores[a].total_cmp(&scores[b]))
+    {
+        Some(k) => (nodes[k].to_vec(), vec![ln10 / 4.0, ln10 / 2.0]),
+        None => (theta0, step),
+    }
+}
+
+/// IRLS around Nelder-Mead from the start `(theta0, step)`: in the coordinates of the
+/// local metric when `opts.rescale` finds one (its last Jacobian returned for reuse),
+/// else in the log-parameters.
+fn minimise(
+    resid: &Resid,
+    objective: &dyn Fn(&[f64], &[f64]) -> f64,
+    (theta0, step): (Vec<f64>, Vec<f64>),
+    n: usize,
+    opts: &DynamicFitOptions,
+    evaluations: &mut usize,
+) -> Result<(IrlsOutcome, Option<TakenJacobian>)> {
     let nm = NmOptions {
         max_evals: opts.max_evals,
         xtol: opts.tol.max(1e-8),
@@ -440,67 +536,67 @@ fn fit_dynamic_body(
         )
     };
     let local = if opts.rescale {
-        local_metric(&resid, theta0.clone(), opts.c1, &mut evaluations)
+        local_metric(resid, theta0.clone(), opts.c1, evaluations)
     } else {
         None
     };
-    let mut reuse_jac = None;
-    let out = match local {
-        Some(lm) => {
-            reuse_jac = Some(lm.jac.clone());
-            // Nelder-Mead in z, theta = centre + T*z: the Gauss-Newton model of the
-            // cost is f*(1 + |z|^2) there, so the thin, tilted sigma0/sigma1 valley
-            // becomes round and the simplex needs few evaluations
-            let to_theta = |z: &[f64]| -> [f64; 2] {
-                [
-                    lm.centre[0] + lm.t[0][0] * z[0] + lm.t[0][1] * z[1],
-                    lm.centre[1] + lm.t[1][0] * z[0] + lm.t[1][1] * z[1],
-                ]
-            };
-            let resid_z = |z: &[f64]| resid(&to_theta(z));
-            // |d theta|_inf <= ||T||_inf * |d z|_inf
-            let tnorm =
-                (lm.t[0][0].abs() + lm.t[0][1].abs()).max(lm.t[1][0].abs() + lm.t[1][1].abs());
-            // a few standard errors: the cost rises by ~1/N relative per standard error
-            let n = t.len() as f64;
-            let step_z = [2.0 / n.sqrt(); 2];
-            let setup = IrlsSetup {
-                weighting: opts.weighting,
-                max_outer: opts.max_iter,
-                tol: opts.tol / tnorm.max(1e-300),
-                scale_floor: opts.scale_floor,
-                nm: NmOptions {
-                    xtol: 1e-8,
-                    ftol: nm.ftol.min(0.04 / n),
-                    ..nm
-                },
-                step: &step_z,
-            };
-            let mut o = irls(&resid_z, &objective, vec![0.0, 0.0], &setup).ok_or_else(fail)?;
-            o.theta = to_theta(&o.theta).to_vec();
-            o
-        }
-        None => {
-            let setup = IrlsSetup {
-                weighting: opts.weighting,
-                max_outer: opts.max_iter,
-                tol: opts.tol,
-                scale_floor: opts.scale_floor,
-                nm,
-                step: &step,
-            };
-            irls(&resid, &objective, theta0, &setup).ok_or_else(fail)?
-        }
+    let Some(lm) = local else {
+        let setup = IrlsSetup {
+            weighting: opts.weighting,
+            max_outer: opts.max_iter,
+            tol: opts.tol,
+            scale_floor: opts.scale_floor,
+            nm,
+            step: &step,
+        };
+        return Ok((
+            irls(resid, objective, theta0, &setup).ok_or_else(fail)?,
+            None,
+        ));
     };
-    evaluations += out.evals;
-    let th = out.theta.clone();
-    let (s0, s1) = (th[0].exp(), th[1].exp());
+    // Nelder-Mead in z, theta = centre + T*z: the Gauss-Newton model of the cost is
+    // f*(1 + |z|^2) there, so the thin, tilted sigma0/sigma1 valley becomes round and
+    // the simplex needs few evaluations
+    let to_theta = |z: &[f64]| -> [f64; 2] {
+        [
+            lm.centre[0] + lm.t[0][0] * z[0] + lm.t[0][1] * z[1],
+            lm.centre[1] + lm.t[1][0] * z[0] + lm.t[1][1] * z[1],
+        ]
+    };
+    let resid_z = |z: &[f64]| resid(&to_theta(z));
+    // |d theta|_inf <= ||T||_inf * |d z|_inf
+    let tnorm = (lm.t[0][0].abs() + lm.t[0][1].abs()).max(lm.t[1][0].abs() + lm.t[1][1].abs());
+    // a few standard errors: the cost rises by ~1/N relative per standard error
+    let n = n as f64;
+    let step_z = [2.0 / n.sqrt(); 2];
+    let setup = IrlsSetup {
+        weighting: opts.weighting,
+        max_outer: opts.max_iter,
+        tol: opts.tol / tnorm.max(1e-300),
+        scale_floor: opts.scale_floor,
+        nm: NmOptions {
+            xtol: 1e-8,
+            ftol: nm.ftol.min(0.04 / n),
+            ..nm
+        },
+        step: &step_z,
+    };
+    let mut o = irls(&resid_z, objective, vec![0.0, 0.0], &setup).ok_or_else(fail)?;
+    o.theta = to_theta(&o.theta).to_vec();
+    Ok((o, Some(lm.jac)))
+}
 
-    // Jacobian of the simulated positions in the log-parameters: the Gauss-Newton one
-    // when it was taken within its own difference step of the estimate, else central
-    // differences here
+/// Jacobian of the simulated positions in the log-parameters at the estimate `th`:
+/// the Gauss-Newton one when it was taken within its own difference step of it, else
+/// central differences here (`None` when a simulation fails).
+fn jacobian_at_estimate(
+    resid: &Resid,
+    th: &[f64],
+    reuse: Option<TakenJacobian>,
+    evaluations: &mut usize,
+) -> Option<[Vec<f64>; 2]> {
     let h = 1e-3;
-    let jac: Option<[Vec<f64>; 2]> = match reuse_jac {
+    match reuse {
         Some((at, j)) if (at[0] - th[0]).abs().max((at[1] - th[1]).abs()) <= h => Some(j),
         _ => {
             let probes: Vec<[f64; 2]> = vec![
@@ -510,7 +606,7 @@ fn fit_dynamic_body(
                 [th[0], th[1] - h],
             ];
             let sims: Vec<Option<Vec<f64>>> = probes.par_iter().map(|p| resid(p)).collect();
-            evaluations += 4;
+            *evaluations += 4;
             match &sims[..] {
                 [Some(a), Some(b), Some(c), Some(d)] => Some([
                     a.iter().zip(b).map(|(p, q)| (p - q) / (2.0 * h)).collect(),
@@ -519,161 +615,5 @@ fn fit_dynamic_body(
                 _ => None,
             }
         }
-    };
-    let w = &out.weights;
-    let e = &out.residuals;
-    let n_used = w.iter().filter(|x| **x > 0.0).count();
-    let mut notes = Vec::new();
-    let mut std_err = vec![f64::NAN; 2];
-    let mut ci_low = vec![f64::NAN; 2];
-    let mut ci_high = vec![f64::NAN; 2];
-    let mut rel = vec![f64::INFINITY; 2];
-    let mut correlation = f64::NAN;
-    // lag-one autocorrelation of the kept residuals
-    let mut num = 0.0;
-    let mut den = 0.0;
-    for k in 0..e.len() {
-        if w[k] > 0.0 {
-            den += w[k] * e[k] * e[k];
-            if k + 1 < e.len() && w[k + 1] > 0.0 {
-                num += (w[k] * w[k + 1]).sqrt() * e[k] * e[k + 1];
-            }
-        }
     }
-    let rho = if den > 0.0 {
-        (num / den).clamp(0.0, 0.999)
-    } else {
-        0.0
-    };
-    let inflation = (1.0 + rho) / (1.0 - rho);
-    let mut singular = false;
-    if let Some([ja, jb]) = &jac {
-        // de/dtheta = -(dx_sim/dtheta); the sign does not matter for J^T W J
-        let mut m = [[0.0f64; 2]; 2];
-        for k in 0..e.len() {
-            let (j0, j1) = (ja[k], jb[k]);
-            m[0][0] += w[k] * j0 * j0;
-            m[0][1] += w[k] * j0 * j1;
-            m[1][1] += w[k] * j1 * j1;
-        }
-        m[1][0] = m[0][1];
-        let dof = n_used as f64 - 2.0;
-        let ssq: f64 = e.iter().zip(w).map(|(ei, wi)| wi * ei * ei).sum();
-        let s2 = if dof > 0.0 { ssq / dof } else { f64::NAN };
-        let det = m[0][0] * m[1][1] - m[0][1] * m[0][1];
-        let scale = (m[0][0] * m[1][1]).max(0.0);
-        let cond_ok = scale > 0.0 && det > 1e-10 * scale;
-        if cond_ok && s2.is_finite() {
-            let c00 = m[1][1] / det * s2 * inflation;
-            let c11 = m[0][0] / det * s2 * inflation;
-            let c01 = -m[0][1] / det * s2 * inflation;
-            correlation = c01 / (c00 * c11).sqrt();
-            let se_th = [c00.sqrt(), c11.sqrt()];
-            let est = [s0, s1];
-            for k in 0..2 {
-                std_err[k] = est[k] * se_th[k];
-                ci_low[k] = est[k] * (-1.96 * se_th[k]).exp();
-                ci_high[k] = est[k] * (1.96 * se_th[k]).exp();
-                rel[k] = (ci_high[k] - ci_low[k]) / (2.0 * est[k]);
-            }
-        } else {
-            singular = true;
-        }
-    } else {
-        singular = true;
-        notes.push("the simulation failed next to the estimate: no intervals".into());
-    }
-    let mut identifiable = vec![false; 2];
-    for k in 0..2 {
-        identifiable[k] = !singular && rel[k].is_finite() && rel[k] <= 0.5;
-    }
-    if singular {
-        notes.push(
-            "the objective is flat in at least one direction (near-singular Hessian): sigma0 and sigma1 cannot be separated by this record".into(),
-        );
-    }
-    if identifiable[0] {
-        notes.push(format!(
-            "sigma0 = {s0:.4e} N/m is determined by the record (95 % interval +-{:.2} %)",
-            rel[0] * 100.0
-        ));
-    } else {
-        notes.push(format!(
-            "sigma0 is NOT determined by this record (95 % interval +-{:.0} %): record small back-and-forth moves below the break-away force (presliding), where the force-displacement slope is sigma0",
-            rel[0] * 100.0
-        ));
-    }
-    if identifiable[1] {
-        notes.push(format!(
-            "sigma1 = {s1:.4} N s/m is determined by the record (95 % interval +-{:.1} %)",
-            rel[1] * 100.0
-        ));
-    } else {
-        notes.push(format!(
-            "sigma1 is NOT determined by this record: the objective is nearly flat in sigma1 (95 % interval +-{:.0} %). Break-away tests with small displacements (force ramps or steps below fs, with fast position sampling) excite the bristle damping; otherwise keep the start value and report it as assumed",
-            rel[1].min(1e6) * 100.0
-        ));
-    }
-    let s2max = model
-        .friction
-        .positive
-        .sigma2
-        .max(model.friction.negative.sigma2);
-    let bias = s2max * opts.sigma2_rel_uncertainty;
-    if bias > 0.1 * s1 {
-        notes.push(format!(
-            "sigma1 is confounded with sigma2 (the presliding damping is sigma1 + sigma2): a {:.1} % error in sigma2 ({bias:.3} N s/m) is {:.0} % of sigma1; reduce sigma2's uncertainty (more fast constant-velocity points) before trusting sigma1",
-            opts.sigma2_rel_uncertainty * 100.0,
-            100.0 * bias / s1
-        ));
-    }
-    if rho > 0.5 {
-        notes.push(format!(
-            "residuals are serially correlated (lag-one {rho:.3}); intervals widened by a factor {:.1}",
-            inflation.sqrt()
-        ));
-    }
-    if correlation.abs() > 0.95 {
-        notes.push(format!(
-            "ln sigma0 and ln sigma1 are strongly correlated ({correlation:.3})"
-        ));
-    }
-    if !out.converged {
-        notes.push(format!(
-            "IRLS stopped at the iteration limit ({}) before the weights settled",
-            out.iterations
-        ));
-    }
-    let wsum: f64 = w.iter().sum();
-    let ssq: f64 = e.iter().zip(w).map(|(ei, wi)| wi * ei * ei).sum();
-    let max_error = e
-        .iter()
-        .zip(w)
-        .filter(|(_, wi)| **wi > 0.0)
-        .fold(0.0f64, |m, (ei, _)| m.max(ei.abs()));
-    Ok(DynamicFit {
-        sigma0: s0,
-        sigma1: s1,
-        std_err,
-        ci_low,
-        ci_high,
-        rel_ci_half_width: rel,
-        identifiable,
-        correlation,
-        residual_autocorrelation: rho,
-        notes,
-        objective: objective(e, w),
-        rms_error: if wsum > 0.0 {
-            (ssq / wsum).sqrt()
-        } else {
-            f64::NAN
-        },
-        max_error,
-        scale: out.scale,
-        residuals: out.residuals,
-        weights: out.weights,
-        iterations: out.iterations,
-        evaluations,
-        converged: out.converged,
-    })
 }
