@@ -18,6 +18,7 @@ import warnings
 from typing import Any, Callable
 
 import numpy as np
+from lugre import reference
 from lugre.diagnosis import residual as R
 from lugre.diagnosis.synth import concealed
 from scipy import signal
@@ -39,7 +40,7 @@ def main() -> None:
     warnings.simplefilter("ignore")
     rec, model, _ = concealed("cogging", duration=20.0)
     sig = R.prepare(rec, model)
-    sigr = R.prepare(rec, model, backend="reference")
+    sigr = R.prepare(rec, model, backend=reference.kernels)
     y = np.random.default_rng(0).standard_normal(len(sig))
     sos = signal.butter(4, sig.cutoff_hz / (0.5 * sig.fs), output="sos")
     res = model.replace(effects=[{"effect": "resonance", "frequency": 22.0,
