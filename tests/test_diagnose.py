@@ -9,7 +9,7 @@ import lugre
 import numpy as np
 import pytest
 from lugre.diagnosis import diagnose, evaluate, fit_inverse_dynamics, write_plots
-from lugre.diagnosis.search import accept, accept_many, block_evidence
+from lugre.diagnosis.scoring import accept, accept_many, block_evidence
 from lugre.diagnosis.synth import concealed
 from lugre.exceptions import DataError
 
@@ -294,7 +294,7 @@ def test_fast_sampling_keeps_the_band_the_position_reading_allows(effect):
 def test_resonance_search_stays_in_its_box():
     # the staged search walks the lattice from the best point; it must not walk out of
     # the band or into overdamped couplings (a damping ratio of 2.3 was once named)
-    from lugre.diagnosis import effects as E
+    from lugre.diagnosis import candidates as E
     from lugre.diagnosis import residual as R
 
     rec, believed, _ = concealed(None, duration=4.0)
@@ -323,9 +323,11 @@ def test_scores_read_on_every_step_th_sample_agree():
     # are band-limited, so the sums agree with the full ones (and a cogging term's
     # gain with them)
     from lugre.diagnosis import base as B
-    from lugre.diagnosis import effects as E
+    from lugre.diagnosis import candidates as E
     from lugre.diagnosis import residual as R
-    from lugre.diagnosis.search import Scorer, Term, make_term
+    from lugre.diagnosis.candidates import Term
+    from lugre.diagnosis.scoring import Scorer
+    from lugre.diagnosis.search import make_term
 
     rec, believed, _ = concealed("cogging", duration=10.0)
     sig = R.prepare(rec, believed)
@@ -737,7 +739,7 @@ def test_the_current_noise_in_the_force_rate_is_predicted():
     # filtered force's rate of change): that noise's mean square, predicted from the
     # level above the band, matches what white current noise gives
     from lugre.diagnosis import residual as R
-    from lugre.diagnosis.evidence import _rate_noise_power
+    from lugre.diagnosis.candidates.probe import rate_noise_power
 
     rng = np.random.default_rng(5)
     n = 20000
@@ -747,7 +749,7 @@ def test_the_current_noise_in_the_force_rate_is_predicted():
         rec = lugre.Recording(t=t, x=x, i=sd * rng.standard_normal(n))
         sig = R.prepare(rec, lugre.Model.paper())
         measured = float(np.mean(sig.dfm[sig.mask] ** 2))
-        assert _rate_noise_power(sig) == pytest.approx(measured, rel=0.1)
+        assert rate_noise_power(sig) == pytest.approx(measured, rel=0.1)
 
 
 @pytest.mark.parametrize("setup", [

@@ -336,7 +336,7 @@ def _cmd_diagnose(args: argparse.Namespace) -> int:
 
 def _cmd_evaluate(args: argparse.Namespace) -> int:
     from .diagnosis import evaluate
-    from .diagnosis.core import level_shift_text
+    from .diagnosis.evaluation import level_shift_text
     from .model import load_model
 
     _check_outputs({"RECORDING": args.recording, "--model": args.model}, {"--json": args.json})

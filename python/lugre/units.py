@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from .vocabulary import EFFECTS
+
 __all__ = ["BASE_UNITS", "EFFECT_UNITS", "display", "fmt", "fmt_range"]
 
 #: Display unit and factor from SI for each quantity.
@@ -17,20 +19,7 @@ SPEED = ("mm/s", 1e3)
 
 #: Units of the effects' parameters (CONTRACT vocabulary), as (unit, factor from SI).
 EFFECT_UNITS: dict[str, dict[str, tuple[str, float]]] = {
-    "cogging": {"amplitude": ("N", 1.0), "pitch": POSITION, "phase": ("rad", 1.0)},
-    "spring": {"stiffness": ("N/m", 1.0), "x0": POSITION},
-    "offset": {"force": ("N", 1.0)},
-    "position_friction": {"positions": POSITION, "scale": ("", 1.0)},
-    "drift": {"gain": ("", 1.0), "time_constant": ("s", 1.0)},
-    "mass": {"delta": ("kg", 1.0)},
-    "delay": {"seconds": ("ms", 1e3), "bandwidth": ("Hz", 1.0)},
-    "current_lag": {"bandwidth": ("Hz", 1.0), "seconds": ("ms", 1e3)},
-    "resonance": {"frequency": ("Hz", 1.0), "damping_ratio": ("", 1.0),
-                  "load_fraction": ("", 1.0)},
-    "deadband": {"current": ("A", 1.0)},
-    "drag": {"coefficient": ("N s²/m²", 1.0)},
-    "stribeck_shape": {"exponent": ("", 1.0)},
-}
+    name: spec.display for name, spec in EFFECTS.items()}
 
 #: Units of the base model's parameters.
 BASE_UNITS: dict[str, tuple[str, float]] = {

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["EFFECTS", "NAMES", "ONE_OF_A_KIND", "Effect", "Parameter", "held_kinds", "kind"]
+__all__ = ["EFFECTS", "NAMES", "ONE_OF_A_KIND", "TIMING", "TIMING_FORMS", "Effect", "Parameter", "held_kinds",
+           "is_timing", "kind"]
 
 
 @dataclass(frozen=True)
@@ -74,6 +75,9 @@ class Effect:
         return self.name.replace("_", " ")
 
 
+#: The kind of both timing forms.
+TIMING = "delay"
+
 _TIMING_EXPERIMENT = "fast reversals or a current chirp up to a few hundred Hz"
 
 #: The vocabulary, in the order of the CONTRACT (and of the core's ``EFFECT_NAMES``).
@@ -91,10 +95,10 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
            "a recording from a cold start lasting several time constants", "t"),
     Effect("mass", (Parameter("delta", "kg"),),
            "fast back-and-forth moves (large accelerations)", "t", additive="delta"),
-    Effect("delay", (Parameter("seconds", "s", "ms", 1e3),), _TIMING_EXPERIMENT, "t",
+    Effect(TIMING, (Parameter("seconds", "s", "ms", 1e3),), _TIMING_EXPERIMENT, "t",
            one_of_a_kind=True, derived=(Parameter("bandwidth", "Hz"),)),
     Effect("current_lag", (Parameter("bandwidth", "Hz"),), _TIMING_EXPERIMENT, "t",
-           kind="delay", one_of_a_kind=True,
+           kind=TIMING, one_of_a_kind=True,
            derived=(Parameter("seconds", "s", "ms", 1e3),)),
     Effect("resonance", (Parameter("frequency", "Hz"), Parameter("damping_ratio", ""),
                          Parameter("load_fraction", "")),
@@ -112,6 +116,9 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
 #: Every effect name, in the vocabulary's order.
 NAMES: tuple[str, ...] = tuple(EFFECTS)
 
+#: The forms of the timing kind: a pure delay, a first-order current lag.
+TIMING_FORMS: tuple[str, ...] = tuple(n for n, e in EFFECTS.items() if e.kind == TIMING)
+
 #: Kinds a model holds once at most (the timing kind is ``delay``, for both forms).
 ONE_OF_A_KIND: tuple[str, ...] = tuple(dict.fromkeys(
     e.kind for e in EFFECTS.values() if e.one_of_a_kind))
@@ -121,6 +128,11 @@ def kind(effect: str) -> str:
     """An effect's kind: its name, but ``delay`` for both timing forms."""
     e = EFFECTS.get(str(effect))
     return e.kind if e is not None else str(effect)
+
+
+def is_timing(effect: str) -> bool:
+    """Whether an effect is a timing term (a delay or a current lag, one kind)."""
+    return kind(effect) == TIMING
 
 
 def held_kinds(effects: list[dict[str, object]]) -> set[str]:

@@ -10,7 +10,8 @@ import numpy as np
 
 from ..io import Recording
 from ..model import Model
-from . import effects as E
+from ..vocabulary import TIMING
+from . import candidates as E
 from . import evidence as V
 from . import residual as R
 from .evaluation import evaluate, metrics
@@ -50,7 +51,7 @@ def _notes(q: Questioned, w: Weighing, sel: Selection, ev: Evidence,
     notes = V.base_notes(base_rep, ev.findings) + ev.joint.noise_notes
     notes += origin_notes(list(q.removed), ev.findings)
     if sel.held_kinds:
-        kinds = sorted({"timing" if k == "delay" else k.replace("_", " ")
+        kinds = sorted({"timing" if k == TIMING else k.replace("_", " ")
                         for k in sel.held_kinds})
         notes.append(f"The model already holds its {' and '.join(kinds)} (one of a kind): "
                      "kept as given, not searched again.")
@@ -93,7 +94,7 @@ def _unexplained(prep: Prepared, w: Weighing, sel: Selection, ev: Evidence,
     if noise_after["rms"] > EXCESS_FLOOR * expected["rms"] > 0:
         excess = {"floor": noise_after["rms"], "expected": expected["rms"]}
     un = V.unexplained(ev.r1, sig, min(w.noise["rms"], noise_after["rms"]),
-                       located["after"], fit["after"], sel.refused.get("delay"),
+                       located["after"], fit["after"], sel.refused.get(TIMING),
                        ev.joint.mass_ways, excess)
     if un is not None and ev.resembles:
         un["resembles"] = ev.resembles

@@ -14,15 +14,15 @@ import numpy as np
 from ..model import Model
 from ..vocabulary import EFFECTS
 from . import base as B
+from . import candidates as E
 from . import evidence as V
 from . import residual as R
+from .candidates import Term
 from .joint import Joint, _Refitter
 from .options import PARTIAL_REST, Options
 from .prepare import Prepared
 from .report import Finding
-from .search import Term
 from .select import Selection
-from .timing import timing_parameters
 from .weigh import Weighing, rms
 
 __all__ = ["Evidence", "gather"]
@@ -119,24 +119,20 @@ def _finding(k: int, prep: Prepared, w: Weighing, sel: Selection, j: Joint,
               accepted[min(k, len(accepted) - 1)] if accepted else {})
     extra = t.cand.describe(t.h, beta, ctx)
     unc = _uncertainty(t, beta, effs, sel, j, sig, w.s2)
-    if t.effect == "drift":
-        unc, extra = V.drift_identifiability(t, float(sig.t[sig.mask][-1]), thr=opts.min_gain)
     if t.effect in sel.lookalike:
         alternatives.setdefault(k, []).append(sel.lookalike[t.effect])
-    if t.effect == "mass":
-        alt_m = V.mass_alternative(float(e0["delta"]), float(w.model.mass), ctx,
-                                   sel.base.scorer.mask)
-        if alt_m is not None:
-            alternatives.setdefault(k, []).append(alt_m)
-    if t.effect == "offset":
-        alt_off, extra = V.offset_alternative(sel.base.scorer, j.terms, sel.ev,
-                                              sel.base.names, sel.base.tol, w.model, sig,
-                                              opts.min_gain)
-        if alt_off is not None:
-            alternatives.setdefault(k, []).append(alt_off)
-    params = {a: v for a, v in e0.items() if a != "effect"}
-    if t.effect == "delay":
-        params = timing_parameters(e0, alternatives.get(k, []))
+    view = E.FindingView(sig=sig, model=w.model, scorer=sel.base.scorer, ev=sel.ev,
+                         names=sel.base.names, tol=sel.base.tol, terms=j.terms,
+                         min_gain=opts.min_gain, alternatives=alternatives.get(k, []))
+    said = t.cand.finding(t, beta, e0, view)
+    if said.uncertainty is not None:
+        unc = said.uncertainty
+    if said.evidence is not None:
+        extra = said.evidence
+    if said.alternatives:
+        alternatives.setdefault(k, []).extend(said.alternatives)
+    params = (said.parameters if said.parameters is not None
+              else {a: v for a, v in e0.items() if a != "effect"})
     out = [Finding(effect=e0["effect"], parameters=params,
                    where=t.cand.where(t.h, beta, ctx), explained=expl,
                    evidence=V.evidence(t, lg, opts.blocks, extra) + _beside_given(w.model, e0),
@@ -199,11 +195,11 @@ def origin_notes(removed: list[dict[str, Any]], findings: list[Finding]) -> list
     against its laps: 0.7 mm)."""
     out = []
     for r in removed:
-        if r["effect"] != "cogging":
+        if r["effect"] != E.Cogging.effect:
             continue
         p_old = float(r["parameters"]["pitch"])
         for f in findings:
-            if f.effect != "cogging" or abs(f.parameters["pitch"] / p_old - 1) > 0.01:
+            if f.effect != E.Cogging.effect or abs(f.parameters["pitch"] / p_old - 1) > 0.01:
                 continue
             dphi = math.remainder(float(f.parameters["phase"])
                                   - float(r["parameters"].get("phase", 0.0)), 2 * math.pi)

@@ -12,13 +12,16 @@ from typing import Any
 import numpy as np
 
 from ..model import Model
+from ..vocabulary import TIMING_FORMS
 from . import base as B
-from . import effects as E
+from . import candidates as E
 from . import residual as R
+from .candidates import Term
 from .options import Options
 from .prepare import Prepared
 from .refit import refine, split
-from .search import Term, accept, compare, make_term, told_apart
+from .scoring import accept, compare, told_apart
+from .search import make_term
 from .select import Selection
 from .simex import noise_made, surrogates
 from .timing import choose_timing
@@ -66,7 +69,7 @@ class _Refitter:
     def fit(self, terms: list[Term], base: dict[str, float], betas: list[np.ndarray],
             alternatives: Alternatives | None = None) -> Joint:
         """The terms refitted; a timing term in the form its exact residual prefers."""
-        t_k = next((j for j, t in enumerate(terms) if t.effect == "delay"), None)
+        t_k = next((j for j, t in enumerate(terms) if t.cand.timing), None)
         if t_k is not None:
             aug, b, bb, ctx, tt, alt = choose_timing(
                 self.model, self.sig, terms, t_k, dict(base), betas, self.w.s2, self.names,
@@ -107,10 +110,10 @@ def _first_fit(rf: _Refitter, sel: Selection, w: Weighing) -> tuple[Joint, dict[
     for n, dv in zip(sel.base.names, d):
         base0[n] += dv
     j = rf.fit(terms, base0, betas)
-    timing = any(t.effect == "delay" for t in terms)
+    timing = any(t.cand.timing for t in terms)
     floor = 0.0 if timing else 0.2 * w.noise["rms"]
     small = [k for k, t in enumerate(j.terms)
-             if not t.minor and t.effect != "delay"
+             if not t.minor and not t.cand.timing
              and rms(t.cand.columns(t.h, j.ctx) @ j.betas[k], rf.sig.mask)
              < max(floor, w.min_force)]
     if small:
@@ -135,17 +138,17 @@ def _weak(rf: _Refitter, j: Joint) -> dict[int, str]:
     attenuation while the selection's timing column was a pure delay; with the lag in
     its exact form it explained nothing more)."""
     terms, betas = j.terms, j.betas
-    named_k = [k for k, t in enumerate(terms) if not t.minor and t.effect != "delay"]
+    named_k = [k for k, t in enumerate(terms) if not t.minor and not t.cand.timing]
     if len([t for t in terms if not t.minor]) < 2 or not named_k:
         return {}
     sse_all = rf.block_sse(j.aug)
     weak = {}
-    t_k = next((i for i, t in enumerate(terms) if t.effect == "delay"), None)
+    t_k = next((i for i, t in enumerate(terms) if t.cand.timing), None)
     for k in named_k:
         keep = [i for i in range(len(terms)) if i != k]
         # without it, the timing term may take either form (a lag's attenuation is what
         # a damped resonance beside a pure delay stands for)
-        forms = [None] if t_k is None else ["delay", "current_lag"]
+        forms = [None] if t_k is None else list(TIMING_FORMS)
         sse_wo = None
         for form in forms:
             tt = [terms[i] if i != t_k or form is None
@@ -244,7 +247,7 @@ def _mass_still(rf: _Refitter, j: Joint, mass_ways: dict[str, Any] | None
     while the selection's timing column was a pure delay)."""
     if mass_ways is None:
         return None
-    mc = next(c for c in E.candidates() if c.effect == "mass")
+    mc = E.Mass()
     mt = make_term(mc, None, j.ctx)
     try:
         out = rf.refine(j.terms + [mt], j.base, j.betas + [np.zeros(mt.X.shape[1])], 3)

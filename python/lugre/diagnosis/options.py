@@ -62,5 +62,5 @@ class Options:
         return replace(self, **changes)
 
     def test(self) -> dict[str, float]:
-        """The block test's keywords (:func:`lugre.diagnosis.search.accept`)."""
+        """The block test's keywords (:func:`lugre.diagnosis.scoring.accept`)."""
         return {"alpha": self.alpha, "min_gain": self.min_gain}

@@ -19,7 +19,7 @@ from . import evidence as V
 from . import residual as R
 from .options import Options
 from .prepare import Prepared
-from .search import Scorer, accept, compare
+from .scoring import Scorer, accept, compare
 from .weigh import variance_unit
 
 __all__ = ["Questioned", "contradicted_beside", "question", "question_effects",

@@ -10,9 +10,10 @@ import numpy as np
 
 from ..model import Model
 from . import base as B
-from . import effects as E
+from . import candidates as E
 from . import residual as R
-from .search import Scorer, Term
+from .candidates import Term
+from .scoring import Scorer
 
 __all__ = ["effects_of", "refine", "split"]
 
@@ -56,7 +57,7 @@ def refine(model: Model, sig: R.Signals, terms: list[Term], base: dict[str, floa
     base : dict
         Base parameter values (start), by path.
     s2 : float
-        Variance unit of the prior (as in :class:`~lugre.diagnosis.search.Scorer`).
+        Variance unit of the prior (as in :class:`~lugre.diagnosis.scoring.Scorer`).
     names : sequence of str
         The base parameters that are free (the others are held at the model's values).
     iters : int, default 3
@@ -85,7 +86,7 @@ def refine(model: Model, sig: R.Signals, terms: list[Term], base: dict[str, floa
         terms = list(terms)
         bm = B.apply_base(model, base)
         for k, t in enumerate(terms):  # keep the overall friction level in the base
-            if t.effect == "position_friction":
+            if t.cand.scales_levels:
                 sc = 1.0 + betas[k]
                 c = float(np.median(sc))
                 betas[k] = sc / c - 1.0

@@ -12,7 +12,8 @@ import numpy as np
 from .. import units as U
 from ..html import plain_text
 from ..model import Model
-from .timing import timing_words
+from ..vocabulary import is_timing
+from .candidates.lag import timing_words
 
 __all__ = ["Diagnosis", "Finding"]
 
@@ -214,7 +215,7 @@ class Diagnosis:
         if not self.findings:
             lines.append("Findings: none beyond noise.")
         for k, f in enumerate(self.findings, 1):
-            if f.effect in ("delay", "current_lag"):
+            if is_timing(f.effect):
                 ps = timing_words(f.effect, f.parameters)
             else:
                 ps = ", ".join(
@@ -230,7 +231,7 @@ class Diagnosis:
             lines.append(f"   {plain_text(f.evidence)}")
             for alt in f.alternatives:
                 ap = alt.get("parameters") or {}
-                if alt["effect"] in ("delay", "current_lag"):
+                if is_timing(str(alt["effect"])):
                     ap_txt = "(" + timing_words(alt["effect"], {
                         **ap, "seconds": alt.get("effective_delay_s", ap.get("seconds"))}) + ")"
                 else:

@@ -13,12 +13,13 @@ import numpy as np
 
 from ..vocabulary import EFFECTS, held_kinds
 from . import base as B
-from . import effects as E
-from . import evidence as V
+from . import candidates as E
+from .candidates import Term
 from .options import RIVAL_SHARE, Options
 from .prepare import Prepared
 from .refit import refine, split
-from .search import Evaluation, Term, forward_select, told_apart
+from .scoring import Evaluation, told_apart
+from .search import forward_select
 from .weigh import BaseSet, Weighing
 
 __all__ = ["Selection", "select"]
@@ -52,28 +53,10 @@ def candidates(w: Weighing, opts: Options) -> tuple[list[E.Candidate], set[str]]
     held = held_kinds(w.model.effects)
     cands = [c for c in E.candidates() if c.effect not in held]
     if opts.free_mass:
-        cands = [c for c in cands if c.effect != "mass"]
+        cands = [c for c in cands if not isinstance(c, E.Mass)]
     if opts.candidates is not None:
         cands = [c for c in cands if c.effect in set(opts.candidates)]
     return cands, held
-
-
-#: Named terms checked by their own physics: (effect, check, the key that refuses it,
-#: why in words). A lag that fits the reversals but not the motion between them is lost
-#: motion; a mass that differs speeding up and braking is no payload; a dead-band that
-#: reads otherwise where the drive brakes is not one dead-band.
-OWN_CHECKS: tuple[tuple[str, Any, str, Any], ...] = (
-    ("delay", V.lag_at_reversals, "reversals_only",
-     lambda c: (f"between the reversals the lag is {c['lag_away_s'] * 1e3:.2g} ms, "
-                f"not {c['lag_s'] * 1e3:.2g} ms (lost motion, not timing)")),
-    ("mass", V.mass_both_ways, "not_payload",
-     lambda c: (f"{c['speeding_up']:+.2g} kg speeding up, {c['braking']:+.2g} kg "
-                "braking (no payload)")),
-    ("deadband", V.deadband_braking, "not_deadband",
-     lambda c: (f"where the drive brakes the axis it reads {c['braking']:.2g} "
-                f"times the band it reads overall ({c['coefficient']:.2g}): no one "
-                "dead-band explains both")),
-)
 
 
 def _searcher(w: Weighing, scorer: Any, opts: Options) -> Any:
@@ -100,13 +83,17 @@ def _refuse(w: Weighing, bs: BaseSet, cands: list[E.Candidate], opts: Options,
     terms, ev, log = found
     run = _searcher(w, bs.scorer, opts)
     refused: dict[str, dict[str, Any]] = {}
-    for effect, check, key, why in OWN_CHECKS:
+    checked = sorted((c for c in cands if type(c).check is not E.Candidate.check),
+                     key=lambda c: c.check_rank)
+    for c in checked:
+        effect = c.effect
         k = next((k for k, t in enumerate(terms) if t.effect == effect and not t.minor), None)
-        chk = None if k is None else check(bs.scorer, terms, k, ev, w.ctx)
-        if chk is None or not chk[key]:
+        chk = None if k is None else terms[k].cand.check(bs.scorer, terms, k, ev, w.ctx)
+        why = None if chk is None else c.refusal(chk)
+        if chk is None or why is None:
             continue
         refused[effect] = chk
-        _not_named(log, effect, why(chk))
+        _not_named(log, effect, why)
         terms, ev, log2 = run([c for c in cands if c.effect not in refused])
         log += log2
     return terms, ev, log, refused

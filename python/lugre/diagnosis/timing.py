@@ -11,59 +11,25 @@ same delay and the choice between them rests on their shapes alone.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 
 from ..model import Model
-from . import effects as E
+from . import candidates as E
 from . import residual as R
-from .evidence import EXPERIMENT
+from .candidates import Term
+from .candidates.lag import (
+    TIMING_EXPERIMENT,
+    effective_delay,
+    timing_parameters,
+    timing_words,
+)
 from .refit import refine
-from .search import Term, told_apart
+from .scoring import told_apart
 
 __all__ = ["choose_timing", "effective_delay", "smoothing_gain", "timing_parameters",
            "timing_words"]
-
-
-def effective_delay(effect: dict[str, Any]) -> float:
-    """Mean delay [s] of the force behind the recorded current for a timing effect."""
-    if effect["effect"] == "delay":
-        return float(effect["seconds"])
-    return 1.0 / (2.0 * math.pi * float(effect["bandwidth"]))
-
-
-def timing_parameters(effect: dict[str, Any],
-                      alternatives: list[dict[str, Any]]) -> dict[str, float]:
-    """A timing finding's parameters in both of its readings.
-
-    ``seconds`` is always the effective delay (for a lag, its mean delay); a lag's
-    ``bandwidth`` is given when the finding is a lag, or a delay whose lag reading the
-    record does not rule out (the lag is then among the alternatives, and its fitted
-    bandwidth is the one given). The augmented model holds the named form only.
-    """
-    out = {"seconds": effective_delay(effect)}
-    if effect["effect"] == "current_lag":
-        out["bandwidth"] = float(effect["bandwidth"])
-    else:
-        lag = next((a for a in alternatives if a.get("effect") == "current_lag"), None)
-        if lag is not None:
-            out["bandwidth"] = float(lag["parameters"]["bandwidth"])
-    return out
-
-
-def timing_words(effect: str, parameters: dict[str, Any]) -> str:
-    """A timing finding's parameters in words: "effective delay 1.3 ms, or a current lag
-    of 125 Hz" for a delay the record does not tell from a lag."""
-    sec = parameters.get("seconds")
-    bw = parameters.get("bandwidth")
-    d = f"effective delay {sec * 1e3:.3g} ms" if isinstance(sec, (int, float)) else ""
-    if effect == "current_lag" and isinstance(bw, (int, float)):
-        return f"bandwidth {bw:.3g} Hz" + (f", {d}" if d else "")
-    if isinstance(bw, (int, float)):
-        return d + f", or a current lag of {bw:.3g} Hz"
-    return d
 
 
 def smoothing_gain(sig: R.Signals, bandwidth: float, n: int, s2: float) -> float:
@@ -133,5 +99,5 @@ def choose_timing(model: Model, sig: R.Signals, terms: list[Term], k: int,
                "effective_delay_s": effective_delay(eff),
                "note": (f"fits the held-out blocks about as well (difference "
                         f"{abs(dd.sum()):.0f} in squared-error units of the noise)"),
-               "experiment": EXPERIMENT[("delay", "current_lag")]}
+               "experiment": TIMING_EXPERIMENT}
     return aug, base_f, betas_f, ctx, terms_f, alt

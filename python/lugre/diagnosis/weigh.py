@@ -11,11 +11,11 @@ import numpy as np
 
 from ..model import Model
 from . import base as B
-from . import effects as E
+from . import candidates as E
 from . import residual as R
 from .options import MIN_SHARE, Options
 from .prepare import Prepared
-from .search import Evaluation, Scorer, accept, compare
+from .scoring import Evaluation, Scorer, accept, compare
 
 __all__ = ["BaseSet", "Weighing", "rms", "variance_unit", "weigh"]
 

@@ -1,0 +1,168 @@
+"""Effects that live along the stroke: cogging and position-dependent friction."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..residual import position_sums
+from .base import Candidate, Context, by
+from .probe import hide, share, under
+
+__all__ = ["Cogging", "PositionFriction"]
+
+
+class Cogging(Candidate):
+    effect = "cogging"
+    chooses = True
+    signature = "a force periodic in position, independent of the direction of motion"
+
+    def _kgrid(self, ctx: Context) -> np.ndarray:
+        """Spatial frequencies [1/m] the record resolves.
+
+        Up to what the slow, well-moving fifth of the record passes within the filter
+        band (a pitch ``p`` crossed at speed ``v`` is a force at ``v/p`` Hz), and at
+        least 20 encoder counts a period; down to 1.5 periods over the stroke.
+        """
+        span = max(ctx.xrange[1] - ctx.xrange[0], 1e-9)
+        kmax = self.kmax(ctx)
+        kmin = 1.5 / span
+        if kmax <= kmin:
+            return np.array([])
+        return np.arange(kmin, kmax, 0.25 / span)
+
+    @staticmethod
+    def kmax(ctx: Context) -> float:
+        """Highest spatial frequency [1/m] the record resolves (see :meth:`_kgrid`)."""
+        sig = ctx.sig
+        moving = np.abs(sig.vf[sig.mask])
+        moving = moving[moving > 0.05 * max(float(moving.max()), 1e-12)]
+        v_slow = float(np.percentile(moving, 20)) if moving.size else 1.0
+        q = max(sig.info.get("quantum", 0.0), 1e-9)
+        return min(1.0 / (20.0 * q), 0.7 * sig.cutoff_hz / max(v_slow, 1e-9))
+
+    @staticmethod
+    def _power(r: np.ndarray, x: np.ndarray, k0: float, dk: float, n: int,
+               sig: Any) -> np.ndarray:
+        """Power of the best sinusoid of ``r`` over ``x`` at ``k0 + j*dk``, ``j < n``
+        (least squares on sin and cos)."""
+        rs, rc, ss, cc, sc = position_sums(sig, x, r, k0, dk, n, squares=True)
+        det = ss * cc - sc * sc
+        bs = (cc * rs - sc * rc) / det
+        bc = (ss * rc - sc * rs) / det
+        return bs * rs + bc * rc
+
+    def choose(self, r: np.ndarray, ctx: Context) -> Any:
+        ks = self._kgrid(ctx)
+        lead = ctx.extra.get("screw_lead")
+        if ks.size == 0:
+            return None
+        m = ctx.sig.mask
+        step = max(1, int(m.sum() // 6000))
+        x = ctx.sig.x[m][::step]
+        rr = r[m][::step] - np.mean(r[m])
+        dk = 0.25 / max(ctx.xrange[1] - ctx.xrange[0], 1e-9)  # the step of _kgrid
+        p = self._power(rr, x, float(ks[0]), dk, ks.size, ctx.sig)
+        k0 = ks[int(np.argmax(p))]
+        span = ctx.xrange[1] - ctx.xrange[0]
+        lo, hi = k0 - 0.3 / span, k0 + 0.3 / span
+        fine = np.linspace(lo, hi, 31)
+        pf = self._power(rr, x, lo, (hi - lo) / 30, 31, ctx.sig)
+        if lead:  # one revolution of the screw and its harmonics: always tried
+            fine = np.concatenate([fine, np.arange(1, 5) / float(lead)])
+            kl = abs(1.0 / float(lead))  # (the power is even in k)
+            pf = np.concatenate([pf, self._power(rr, x, kl, kl, 4, ctx.sig)])
+        k1 = float(fine[int(np.argmax(pf))])
+        self.spectrum = (ks, p)
+        return 1.0 / k1
+
+    def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
+        return (f"The residual's spectrum over position peaks at a pitch of {h * 1e3:.4g} mm "
+                f"(searched from {1e3 / self.kmax(ctx):.3g} mm, what the slowest fifth of "
+                "the motion resolves in the filter band, to the stroke).")
+
+    figure = by("x", "position [m]")
+
+    def columns(self, h: Any, ctx: Context) -> np.ndarray:
+        ph = 2.0 * np.pi * ctx.sig.x / h
+        return ctx.sig.filt(np.column_stack([np.sin(ph), np.cos(ph)]))
+
+    def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
+        amp = float(math.hypot(beta[0], beta[1]))
+        phase = float(math.atan2(beta[1], beta[0]))
+        return [{"effect": "cogging", "amplitude": amp, "pitch": float(h), "phase": phase}]
+
+    def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
+        sig = ctx.sig
+        span = ctx.xrange[1] - ctx.xrange[0]
+        kmax = self.kmax(ctx)
+        ks = np.geomspace(1.5 / max(span, 1e-9), max(kmax, 2.0 / max(span, 1e-9)), 8)
+        amps = sizes([sig.filt(np.sin(2 * np.pi * k * sig.x)) for k in ks])
+        seen = np.isfinite(amps)
+        b = float(np.max(amps[seen])) if seen.any() else float("inf")
+        blind = ""
+        if seen.any() and not seen.all():
+            pb = 1e3 / ks[~seen]
+            blind = (f" (of any size at pitches near {pb.min():.3g} to {pb.max():.3g} "
+                     "mm: what the friction levels cannot absorb lies in one "
+                     "held-out stretch)")
+        txt = (f"a cogging {under(b, '{:.2g} N')} at pitches {1e3 / ks[-1]:.3g} to "
+               f"{1e3 / ks[0]:.3g} mm{blind}, or any at pitches under "
+               f"{1e3 / kmax:.3g} mm (faster than the filter band at this record's "
+               "slowest motion),")
+        return hide(self.effect, b, "N", txt, experiment=(
+            "slow constant-speed passes (a few mm/s) show short pitches"))
+
+    def where(self, h: Any, beta: np.ndarray, ctx: Context) -> dict[str, Any]:
+        return {"position": list(ctx.xrange), "time": None, "velocity": None}
+
+
+class PositionFriction(Candidate):
+    effect = "position_friction"
+    scales_levels = True
+    signature = ("a change of the Coulomb/static friction level along the guideway: it "
+                 "changes sign with the direction of motion and depends on position")
+
+    def knots(self, ctx: Context) -> np.ndarray:
+        lo, hi = ctx.xrange
+        n = int(np.clip(round((hi - lo) / 0.01), 8, 24)) + 1
+        return np.linspace(lo, hi, n)
+
+    def columns(self, h: Any, ctx: Context) -> np.ndarray:
+        kn = self.knots(ctx)
+        x = np.clip(ctx.sig.x, kn[0], kn[-1])
+        eye = np.eye(kn.size)
+        hats = np.column_stack([np.interp(x, kn, eye[j]) for j in range(kn.size)])
+        return ctx.sig.filt(hats * ctx.fcs[:, None])
+
+    def prior_tol(self, h: Any, ctx: Context) -> np.ndarray | None:
+        return np.full(self.knots(ctx).size, 0.3)
+
+    def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
+        kn = self.knots(ctx)
+        scale = np.maximum(1.0 + np.asarray(beta, float), 0.05)
+        return [{"effect": "position_friction", "positions": [float(p) for p in kn],
+                 "scale": [float(s) for s in scale]}]
+
+    def where(self, h: Any, beta: np.ndarray, ctx: Context) -> dict[str, Any]:
+        kn = self.knots(ctx)
+        dev = np.abs(np.asarray(beta, float))
+        big = np.flatnonzero(dev >= 0.25 * dev.max()) if dev.max() > 0 else np.array([])
+        if big.size == 0:
+            return {"position": None, "time": None, "velocity": None}
+        lo = kn[max(big[0] - 1, 0)]
+        hi = kn[min(big[-1] + 1, kn.size - 1)]
+        return {"position": [float(lo), float(hi)], "time": None, "velocity": None}
+
+    def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
+        sig = ctx.sig
+        span = ctx.xrange[1] - ctx.xrange[0]
+        b = share(float(sizes([sig.filt(ctx.fcs * (np.abs(sig.x - np.mean(sig.x))
+                                                   < 0.1 * span))])[0]))
+        return hide(self.effect, b, "-", f"a friction change {under(100 * b, '{:.2g} %')} "
+                    "over a tenth of the stroke")
+
+
+PositionFriction.figure = by("x", "position [m]")  # type: ignore[method-assign]

@@ -1,0 +1,213 @@
+"""Effects with a nonlinear parameter searched over a grid, by the change of the residual
+the effect makes: a Stribeck shape and a dead-band."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ...model import Model
+from ...vocabulary import is_timing
+from .. import residual as R
+from ..residual import Signals
+from .base import Candidate, Context, by, grid_interval
+from .probe import amps, hide, refit_on, start_of
+
+__all__ = ["Deadband", "StribeckShape", "_Secant"]
+
+
+class _Secant(Candidate):
+    """An effect with a nonlinear parameter ``h``, searched over a grid.
+
+    Its column is the change of the residual that the effect at ``h`` makes (the
+    secant), with a coefficient near 1 when ``h`` is right; :meth:`from_secant` maps a
+    coefficient to the parameter it stands for, and the joint refit re-linearises there.
+    """
+
+    needs_grid = True
+
+    def effect_at(self, h: Any) -> dict[str, Any]:
+        raise NotImplementedError
+
+    def from_secant(self, h: Any, b: float) -> Any:
+        return h
+
+    def _r_base(self, ctx: Context) -> np.ndarray:
+        key = ("r_base", id(ctx.model))
+        if key not in ctx.extra:
+            ctx.extra[key] = R.residual(ctx.model, ctx.sig)
+        return ctx.extra[key]
+
+    def _with(self, h: Any, ctx: Context) -> Model:
+        return ctx.model.replace(effects=list(ctx.model.effects) + [self.effect_at(h)])
+
+    def columns(self, h: Any, ctx: Context) -> np.ndarray:
+        return (self._r_base(ctx) - R.residual(self._with(h, ctx), ctx.sig))[:, None]
+
+    def columns_many(self, hs: list[Any], ctx: Context) -> list[np.ndarray] | None:
+        """The columns of several grid points at once (the kernel runs them in
+        parallel), or None when this candidate builds its columns otherwise."""
+        if type(self).columns is not _Secant.columns:
+            return None
+        r0 = self._r_base(ctx)
+        rs = ctx.sig.kernel.residuals([self._with(h, ctx) for h in hs])
+        return [(r0 - rs[:, j])[:, None] for j in range(len(hs))]
+
+    def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
+        return [self.effect_at(self.from_secant(h, float(beta[0])))]
+
+    def recenter(self, h: Any, beta: np.ndarray, ctx: Context) -> tuple[Any, np.ndarray]:
+        return self.from_secant(h, float(beta[0])), np.ones(1)
+
+    def uncertainty(self, term: Any, beta: np.ndarray, ctx: Context, sig: Signals,
+                    s2: float) -> dict[str, Any]:
+        pr = term.profile
+        if pr is None:
+            return {}
+        ok = pr["score"] <= pr["score"].min() + 10.0
+        out: dict[str, Any] = {"criterion": "held-out score within 10 of the best"}
+        hs = [self.from_secant(h, float(b[0])) for h, b in zip(pr["h_obj"], pr["beta"])]
+        for name, vals in self.interval_params(hs, ok).items():
+            out[name] = vals
+        return out
+
+    def interval_params(self, hs: list[Any], ok: np.ndarray) -> dict[str, list[float]]:
+        return grid_interval({self.param: np.array([float(h) for h in hs])}, ok)
+
+    param = ""
+
+
+class StribeckShape(_Secant):
+    effect = "stribeck_shape"
+    param = "exponent"
+    signature = ("a Stribeck curve of another shape: the friction falls from its static to "
+                 "its Coulomb level more gradually (exponent under 2) or more abruptly")
+
+    def grid(self, ctx: Context) -> np.ndarray | None:
+        return np.array([0.5, 0.65, 0.8, 1.0, 1.25, 1.55, 2.6, 3.3, 4.2])
+
+    def effect_at(self, h: Any) -> dict[str, Any]:
+        return {"effect": "stribeck_shape", "exponent": float(h)}
+
+    def from_secant(self, h: Any, b: float) -> Any:
+        return float(np.clip(2.0 + b * (float(h) - 2.0), 0.2, 10.0))
+
+    def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
+        return "It lives at slow speeds, where the friction falls from static to Coulomb."
+
+    def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
+        sig, m = ctx.sig, ctx.model
+        hump = min(m.positive["fs"] / m.positive["fc"], m.negative["fs"] / m.negative["fc"])
+        slow = float(np.mean(np.abs(sig.vf[sig.mask]) < 3 * min(m.positive["vs"],
+                                                                  m.negative["vs"])))
+        exp = ("steady slow feeds at 0.3 to 3 times the Stribeck velocity in both directions "
+               "would show it")
+        if hump < 1.02:
+            return hide(self.effect, float("inf"), "-", "the shape of the Stribeck curve (the "
+                        "model has no static level above the Coulomb level, fs = fc)",
+                        experiment=exp)
+        b = float(sizes([self.columns(1.0, ctx)[:, 0]])[0])  # exponent 2 -> 1
+        if not np.isfinite(b) or b > 5:
+            return hide(self.effect, float("inf"), "-", "the shape of the Stribeck curve",
+                        experiment=exp)
+        return hide(self.effect, b, "-", f"a Stribeck exponent within {b:.2g} of 2",
+                    experiment=exp if slow < 0.05 else "")
+
+    figure = by("v", "velocity [m/s]")
+
+
+class Deadband(_Secant):
+    effect = "deadband"
+    param = "current"
+    signature = ("a dead-band of the drive: small currents give no force, so the motor "
+                 "force lags the command at every change of the current's sign")
+
+    def grid(self, ctx: Context) -> np.ndarray | None:
+        ia = np.abs(ctx.sig.fm[ctx.sig.mask]) / ctx.model.force_constant
+        top = float(np.percentile(ia, 50))
+        if not top > 0:
+            return None
+        return top * np.geomspace(0.01, 0.8, 12)
+
+    def effect_at(self, h: Any) -> dict[str, Any]:
+        return {"effect": "deadband", "current": float(h)}
+
+    def columns(self, h: Any, ctx: Context) -> np.ndarray:
+        if any(is_timing(e["effect"]) or e["effect"] == self.effect
+               for e in ctx.model.effects):
+            return super().columns(h, ctx)
+        sig = ctx.sig
+        # r(without) - r(with): only the motor force changes
+        return (sig.fm_f - sig.filt(R.deadband(sig.fm, float(h) * ctx.model.force_constant))
+                )[:, None]
+
+    def from_secant(self, h: Any, b: float) -> Any:
+        return float(max(b * float(h), 0.0))
+
+    def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
+        d = self.from_secant(h, float(beta[0]))
+        return (f"Currents under {d * 1e3:.3g} mA give no force ({d * ctx.model.force_constant:.3g}"
+                " N of motor force lost at each sign change of the current).")
+
+    def figure(self, residual: np.ndarray, contrib: np.ndarray, ctx: Context
+               ) -> dict[str, Any]:
+        m = ctx.sig.mask
+        i = ctx.sig.fm_f[m] / ctx.model.force_constant
+        o = np.argsort(i, kind="stable")
+        return {"x": i[o], "xlabel": "current [A]", "residual": residual[m][o],
+                "effect": contrib[m][o]}
+
+    check_rank = 2
+
+    def check(self, scorer: Any, terms: list[Any], k: int, ev: Any, ctx: Context
+              ) -> dict[str, Any] | None:
+        return deadband_braking(scorer, terms, k, ev, ctx)
+
+    def refusal(self, chk: dict[str, Any]) -> str | None:
+        if not chk["not_deadband"]:
+            return None
+        return (f"where the drive brakes the axis it reads {chk['braking']:.2g} "
+                f"times the band it reads overall ({chk['coefficient']:.2g}): no one "
+                "dead-band explains both")
+
+    def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
+        d0 = 0.02
+        b = d0 * float(sizes([self.columns(d0, ctx)[:, 0]])[0])
+        kf = ctx.model.force_constant
+        return hide(self.effect, b, "A", (f"a dead-band under {amps(b)} ({b * kf:.2g} N of "
+                                          "motor force)" if np.isfinite(b)
+                                          else "a dead-band of any size"))
+
+
+def deadband_braking(scorer: Any, terms: list[Any], k: int, ev: Any,
+                     ctx: Any) -> dict[str, Any] | None:
+    """Is the dead-band term ``terms[k]`` a dead-band, the same where the drive brakes?
+
+    A dead-band takes force away along the current: wherever the current is over the
+    band, the logged force is ``b`` more than what acts, in the current's direction.
+    More friction than the model holds also needs more force, but along the motion.
+    The two agree while the drive pushes the axis along (force and velocity of one
+    sign, most of a record) and part while it brakes: there a dead-band still takes
+    force along the current, against the motion. The term is refitted, jointly with
+    the base and the other terms, on the samples where the drive brakes the moving axis
+    (``F*v < 0``); when they determine it (standard error under a quarter of the full
+    fit's) and it differs from the full fit by more than four standard errors and by
+    more than half, no one dead-band explains both: the term stands for something else
+    (a friction bump on part of the stroke read 0.56 of its band overall and 2.0 +- 0.13
+    braking; dead-bands of 2-150 mA on the generator read within 0.35 and 5 standard
+    errors). Returns the figures, or None when the record cannot tell.
+    """
+    sig = ctx.sig
+    m = scorer.mask
+    vmax = float(np.max(np.abs(sig.vf[m])))
+    brake = m & (sig.fm_f * sig.vf < 0) & (np.abs(sig.vf) > 0.02 * vmax)
+    full = float(ev.beta[start_of(scorer, terms, k)])
+    # (braking is rare where friction stops the axis: the standard error decides)
+    fit = refit_on(scorer, terms, k, brake) if full > 0 and brake.sum() >= 20 else None
+    if fit is None:
+        return None
+    b, se = fit
+    return {"coefficient": full, "braking": b, "braking_se": se,
+            "not_deadband": bool(se < 0.25 * full and abs(b - full) > 4.0 * se
+                                 and abs(b - full) > 0.5 * full)}
