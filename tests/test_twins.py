@@ -106,15 +106,20 @@ def test_reference_offers_the_facade_names():
 
 def test_reference_never_calls_the_core(monkeypatch):
     """With the core's functions replaced by traps, the reference still runs."""
-    from lugre import _core
+    from lugre import _core, _native
 
     rec, _ = _stick_slip_record(duration=0.3)  # data made by the core, before the traps
     def trap(*args, **kwargs):
         raise AssertionError("lugre.reference called lugre._core")
 
+    # (a lugre.Model is validated by the core's Model, the one validation; the twin's
+    # numbers come from its own parser, reference/parsed.py)
     for name in dir(_core):
-        if not name.startswith("_") and callable(getattr(_core, name)):
+        if not name.startswith("_") and name != "Model" and callable(getattr(_core, name)):
             monkeypatch.setattr(_core, name, trap)
+    for name in dir(_native):  # and the facade's own handles on them
+        if name.startswith("core_"):
+            monkeypatch.setattr(_native, name, trap)
     m = lugre.Model.paper()
     t = np.arange(0, 0.01, 1e-4)
     ref.stribeck([0.1], m)
@@ -143,7 +148,7 @@ def test_stribeck_twins():
     np.testing.assert_array_equal(lugre.stribeck(list(v), m), b)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=40, deadline=None, derandomize=True)
 @given(
     v=st.lists(st.floats(-0.5, 0.5), min_size=1, max_size=300),
     dt=st.floats(1e-6, 1e-2),
@@ -320,8 +325,8 @@ BAD_MODELS = [
 
 
 def unchecked(d):
-    """A :class:`Model` around ``d`` that skipped the Python checks, so that each backend
-    meets the bad value itself: the core in its JSON, the reference in its document.
+    """A :class:`Model` around ``d`` that skipped its checks, so that each backend meets
+    the bad value itself: the core in its JSON, the reference in its own parser.
 
     NaN and inf cannot be written in JSON: such a document stays a dict, which both
     backends check in Python before anything else (the core never sees them)."""
@@ -347,7 +352,7 @@ def test_bad_parameters_same_errors(path, edit, call):
     d = lugre.Model.paper().to_dict()
     edit(d)
     with pytest.raises(lugre.ParameterError) as py_err:
-        Model.from_dict(d)  # the Python check, which the calls below bypass
+        Model.from_dict(d)  # the model's check (the core's), which the calls below bypass
     msgs = []
     for backend in BACKENDS:
         with pytest.raises(lugre.ParameterError) as e:
@@ -490,7 +495,7 @@ def test_resonance_refusal_messages_equal():
 # ---- friction_force with stribeck_shape and scale ----------------------------------------
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=40, deadline=None, derandomize=True)
 @given(
     data=st.lists(st.tuples(st.floats(-0.5, 0.5), st.floats(0.2, 3.0)), min_size=1,
                   max_size=300),
@@ -618,14 +623,22 @@ def assert_same_static(a, b, rel=0.0):
     np.testing.assert_array_equal(a.weights, b.weights)
     for d in ("positive", "negative"):
         x, y = getattr(a, d), getattr(b, d)
-        assert (x.iterations, x.converged) == (y.iterations, y.converged), d
+        # within the stopping rule's tolerance the IRLS loop may stop at another pass
+        # with the same points kept and the same parameters (measured: 7 passes against
+        # 1 on a tukey fit of 20 points, parameters 1e-9 apart); bit for bit it may not
+        assert x.converged == y.converged, d
+        assert rel > 0 or x.iterations == y.iterations, d
         np.testing.assert_array_equal(x.indices, y.indices)
         np.testing.assert_array_equal(x.weights, y.weights)
         for k in x.params:
-            assert x.params[k] == pytest.approx(y.params[k], rel=rel, abs=0), (d, k)
+            # (a parameter near zero, a sigma2 of 0.05 N s/m, is compared on the scale of
+            # its standard error: 1e-3 of it, where the stopping rule leaves 1e-5)
+            se = 1e-3 * x.std_err[k] if rel > 0 else 0.0
+            assert x.params[k] == pytest.approx(y.params[k], rel=rel, abs=se), (d, k)
             np.testing.assert_allclose(x.std_err[k], y.std_err[k], rtol=max(rel, 1e-300))
-            np.testing.assert_allclose(x.ci95[k], y.ci95[k], rtol=max(rel, 1e-300))
-        np.testing.assert_allclose(x.cov, y.cov, rtol=max(rel, 1e-300))
+            np.testing.assert_allclose(x.ci95[k], y.ci95[k], rtol=max(rel, 1e-300), atol=se)
+        np.testing.assert_allclose(x.cov, y.cov, rtol=max(rel, 1e-300),
+                                   atol=rel * np.max(np.abs(x.cov)))
         np.testing.assert_allclose(x.residuals, y.residuals,
                                    rtol=0, atol=rel * max(np.max(np.abs(x.residuals)), 1.0))
         assert x.scale == pytest.approx(y.scale, rel=rel, abs=0)
@@ -648,7 +661,7 @@ def test_fit_static_twins_on_shared_points(weighting):
     assert_same_static(a, b)
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=25, deadline=None, derandomize=True)
 @given(
     n=st.integers(5, 20),
     fc=st.floats(2.0, 80.0),
@@ -1105,7 +1118,7 @@ def _outcome(call):
         return None, (type(e), str(e))
 
 
-@settings(max_examples=80, deadline=None)
+@settings(max_examples=80, deadline=None, derandomize=True)
 @given(case=plateau_records())
 def test_steady_state_points_twins_generated(case):
     """Random plateau records: the facades agree bit for bit, or refuse alike; so do the

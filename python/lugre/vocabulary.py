@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["EFFECTS", "NAMES", "ONE_OF_A_KIND", "TIMING", "TIMING_FORMS", "Effect", "Parameter", "held_kinds",
+__all__ = ["EFFECTS", "MASS_EFFECTS", "NAMES", "ONE_OF_A_KIND", "TIMING", "TIMING_FORMS", "Effect", "Parameter", "held_kinds",
            "is_timing", "kind"]
 
 
@@ -43,7 +43,8 @@ class Effect:
     ``one_of_a_kind``: a model holds it once at most; ``additive``: the parameter that
     adds up when two of it act (a finding beside the model's own corrects it);
     ``abscissa``: ``x``, ``v`` or ``t``, what its figure is drawn against;
-    ``derived``: parameters a report gives beside the file's (a lag's mean delay).
+    ``derived``: parameters a report gives beside the file's (a lag's mean delay);
+    ``adds_mass``: its ``additive`` parameter adds to the moving mass [kg].
     """
 
     name: str
@@ -54,6 +55,7 @@ class Effect:
     one_of_a_kind: bool = False
     additive: str | None = None
     derived: tuple[Parameter, ...] = ()
+    adds_mass: bool = False
 
     def __post_init__(self) -> None:
         if not self.kind:
@@ -94,7 +96,8 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
     Effect("drift", (Parameter("gain", ""), Parameter("time_constant", "s")),
            "a recording from a cold start lasting several time constants", "t"),
     Effect("mass", (Parameter("delta", "kg"),),
-           "fast back-and-forth moves (large accelerations)", "t", additive="delta"),
+           "fast back-and-forth moves (large accelerations)", "t", additive="delta",
+           adds_mass=True),
     Effect(TIMING, (Parameter("seconds", "s", "ms", 1e3),), _TIMING_EXPERIMENT, "t",
            one_of_a_kind=True, derived=(Parameter("bandwidth", "Hz"),)),
     Effect("current_lag", (Parameter("bandwidth", "Hz"),), _TIMING_EXPERIMENT, "t",
@@ -115,6 +118,9 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
 
 #: Every effect name, in the vocabulary's order.
 NAMES: tuple[str, ...] = tuple(EFFECTS)
+
+#: Effects that add to the moving mass (by their ``additive`` parameter).
+MASS_EFFECTS: tuple[str, ...] = tuple(n for n, e in EFFECTS.items() if e.adds_mass)
 
 #: The forms of the timing kind: a pure delay, a first-order current lag.
 TIMING_FORMS: tuple[str, ...] = tuple(n for n, e in EFFECTS.items() if e.kind == TIMING)

@@ -10,8 +10,9 @@ show the fit improve.
 
 from __future__ import annotations
 
+from .chain import fit_model
 from .core import diagnose, evaluate
-from .inverse import fit_inverse_dynamics, fit_model
+from .inverse import fit_inverse_dynamics
 from .locate import locate
 from .plots import write_plots
 from .report import Diagnosis, Finding

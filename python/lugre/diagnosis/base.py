@@ -52,11 +52,11 @@ def get_base(model: Model, name: str) -> float:
     """Value of a base parameter by its path (``mass``, ``positive.fc``, ``sigma0``)."""
     if name == "mass":
         return float(model.mass)
-    f = model._parsed.friction  # (as validated: no copy of the document)
+    f = model._data["friction"]  # (as validated: no copy of the document)
     if "." in name:
         d, k = name.split(".")
-        return float(getattr(getattr(f, d), k))
-    return float(getattr(f, name))
+        return float(f[d][k])
+    return float(f[name])
 
 
 def apply_base(model: Model, values: dict[str, float]) -> Model:

@@ -360,7 +360,7 @@ def _profile_side(sig: R.Signals, best: Model, name: str, val: float, sgn: float
 
 def identify(recording: Any, *, mass: float | None = None, force_constant: float = 1.0,
              cutoff_hz: float | None = None, controller: dict[str, Any] | None = None,
-             backend: str = "core", profiles: bool = True) -> BaseFitResult:
+             backend: Any = "core", profiles: bool = True) -> BaseFitResult:
     """Identify an axis's base model from a recording: the inverse-dynamics levels
     (robust linear least squares) as the start of :func:`fit_base`.
 
@@ -376,8 +376,9 @@ def identify(recording: Any, *, mass: float | None = None, force_constant: float
         Low-pass cut-off (default ``fs/25``).
     controller : dict, optional
         Controller section to put in the model.
-    backend : {"core", "reference"}
-        The kernels of the compiled core or of the NumPy twin.
+    backend : "core" or module, default "core"
+        The kernels: the compiled core, or a kernels module such as
+        :mod:`lugre.reference.kernels` (the NumPy twin; slower, for checking).
     profiles : bool, default True
         Intervals and determinacy of every parameter.
 
@@ -386,7 +387,7 @@ def identify(recording: Any, *, mass: float | None = None, force_constant: float
     BaseFitResult
     """
     from ..exceptions import PassivityWarning
-    from .core import as_recording
+    from .evaluation import as_recording
 
     with warnings.catch_warnings():  # the starts and trial models; the result is checked
         warnings.simplefilter("ignore", PassivityWarning)
@@ -396,7 +397,7 @@ def identify(recording: Any, *, mass: float | None = None, force_constant: float
 
 
 def _identify(rec: Any, mass: float | None, force_constant: float, cutoff_hz: float | None,
-              controller: dict[str, Any] | None, backend: str, profiles: bool
+              controller: dict[str, Any] | None, backend: Any, profiles: bool
               ) -> BaseFitResult:
     from .inverse import fit_inverse_dynamics
 
@@ -420,7 +421,7 @@ def _identify(rec: Any, mass: float | None, force_constant: float, cutoff_hz: fl
     return with_profiles(sig, res, shift)
 
 
-def sampling_shift(rec: Any, res: BaseFitResult, *, cutoff_hz: float | None, backend: str,
+def sampling_shift(rec: Any, res: BaseFitResult, *, cutoff_hz: float | None, backend: Any,
                    free_mass: bool) -> dict[str, float]:
     """How far each parameter moves when the record is read at half its rate (every
     other sample), the fit polished from ``res``: the bristles advanced over twice the

@@ -53,7 +53,7 @@ def diagnose(
     screw_lead: float | None = None,
     free_mass: bool = False,
     tolerance: float = 1.0,
-    backend: str = "core",
+    backend: Any = "core",
 ) -> Diagnosis:
     """Find the physics a model leaves out of a recording.
 
@@ -88,9 +88,9 @@ def diagnose(
         Scale of the base parameters' tolerances (the prior on how far they may move
         from the model): 1 diagnoses a model believed about right; identification from
         a rough start uses a wide one.
-    backend : {"core", "reference"}, default "core"
-        Numerics from the compiled core, or from its NumPy twin ``lugre.reference``
-        (the same diagnosis, slower; for checking).
+    backend : "core" or module, default "core"
+        The kernels: the compiled core, or a kernels module such as
+        :mod:`lugre.reference.kernels` (the NumPy twin; slower, for checking).
 
     Returns
     -------

@@ -86,7 +86,7 @@ def level_shift_text(ls: dict[str, Any] | None) -> str | None:
 
 
 def evaluate(recording: Any, model: Any, *, cutoff_hz: float | None = None,
-             backend: str = "core") -> dict[str, Any]:
+             backend: Any = "core") -> dict[str, Any]:
     """Inverse-dynamics force residual of a recording against a model.
 
     ``r = K_F*i - m*a - F_friction - sum(F_effect)`` with every term low-passed by the
@@ -101,8 +101,9 @@ def evaluate(recording: Any, model: Any, *, cutoff_hz: float | None = None,
         The model (its effects included).
     cutoff_hz : float, optional
         Low-pass cut-off (default ``fs/25``).
-    backend : {"core", "reference"}, default "core"
-        The compiled kernel or its NumPy twin.
+    backend : "core" or module, default "core"
+        The kernels: the compiled core, or a kernels module such as
+        :mod:`lugre.reference.kernels` (the NumPy twin; slower, for checking).
 
     Returns
     -------

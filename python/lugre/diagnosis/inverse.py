@@ -11,10 +11,10 @@ import numpy as np
 from ..exceptions import DataError
 from ..model import Model
 from . import residual as R
-from .core import IDENTIFY_TOLERANCE, as_recording
+from .evaluation import as_recording
+from .options import IDENTIFY_TOLERANCE
 
-__all__ = ["IDENTIFY_TOLERANCE", "fit_inverse_dynamics", "fit_model"]
-
+__all__ = ["IDENTIFY_TOLERANCE", "fit_inverse_dynamics"]
 
 
 def fit_inverse_dynamics(
@@ -135,91 +135,3 @@ def fit_inverse_dynamics(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return Model(doc)
-
-
-def fit_model(
-    recording: Any,
-    *,
-    effects: list[str] | None = None,
-    mass: float | None = None,
-    force_constant: float = 1.0,
-    cutoff_hz: float | None = None,
-    screw_lead: float | None = None,
-    backend: Any = "core",
-) -> tuple[Model, Any]:
-    """Identify an axis model from a recording, with extra physics when asked.
-
-    The base (mass and per-direction LuGre friction) by
-    :func:`lugre.diagnosis.basefit.identify`: the robust inverse-dynamics levels as the
-    start of a robust Levenberg-Marquardt fit of every base parameter on the residual
-    with the bristle state driven by the measured motion, from starts over the Stribeck
-    hump and the bristle stiffness, with each parameter's interval from its profile.
-    Then, when ``effects`` names some, the diagnosis searches those with the base
-    re-estimated alongside; an effect the record does not support is left out and said
-    so in the returned diagnosis (its trials and notes).
-
-    Parameters
-    ----------
-    recording : Recording or path
-        With motion in both directions.
-    effects : list of str, optional
-        Effects to identify with the base (e.g. ``["resonance", "drag"]``); default none.
-    mass : float, optional
-        Known moving mass [kg]; estimated otherwise.
-    force_constant : float, default 1.0
-        K_F [N/A] (needed when the recording holds the current).
-    cutoff_hz : float, optional
-        Low-pass cut-off (default ``fs/25``).
-    screw_lead : float, optional
-        Ball-screw lead [m] (tried for cogging).
-    backend : "core" or module, default "core"
-        The kernels (:func:`lugre.diagnosis.residual.kernels`) of the compiled core, or
-        the NumPy twins (:mod:`lugre.reference.kernels`).
-
-    Returns
-    -------
-    model : Model
-        The identified model (base and the effects the record supports).
-    fit : BaseFitResult
-        The base fit: intervals, what the record determines, the residual against its
-        noise floor; ``fit.diagnosis`` the search for ``effects`` (None without).
-    """
-    from dataclasses import replace
-
-    from ..exceptions import InputError
-    from .basefit import identify
-    from .core import diagnose
-    from .effects import candidates
-
-    known = {c.effect for c in candidates()} | {"current_lag"}
-    wanted = list(effects or [])
-    for e in wanted:
-        if e not in known:
-            raise InputError.at("effects", f'unknown effect "{e}": use some of '
-                                f'{", ".join(sorted(known))}')
-    if "current_lag" in wanted and "delay" not in wanted:
-        wanted.append("delay")  # one timing candidate; its form is chosen by the record
-    rec = as_recording(recording)
-    res = identify(rec, mass=mass, force_constant=force_constant, cutoff_hz=cutoff_hz,
-                   backend=backend)
-    if not wanted:
-        return res.model, res
-    dg = diagnose(rec, res.model, candidates=wanted, free_mass=mass is None,
-                  cutoff_hz=cutoff_hz, screw_lead=screw_lead, closed_loop=False,
-                  tolerance=IDENTIFY_TOLERANCE, backend=backend)
-    model = dg.augmented_model()
-    if mass is not None:
-        model = model.replace(axis={**model.axis, "mass": float(mass)})
-    if not dg.findings:
-        return res.model, replace(res, diagnosis=dg)
-    # the base fitted again with the effects found held in it: the search refits the
-    # levels only near the base it was given, which the effects had pulled astray (a
-    # cogging on the slow samples doubles a hump)
-    from . import residual as R
-    from .basefit import fit_base
-
-    sig = R.prepare(rec, model, cutoff_hz=cutoff_hz, backend=backend)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        final = fit_base(sig, model, free_mass=mass is None)  # (model: the first start)
-    return final.model, replace(final, diagnosis=dg)

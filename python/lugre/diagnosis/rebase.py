@@ -34,7 +34,7 @@ def _rms(r: np.ndarray, mask: np.ndarray) -> float:
 
 
 def far_base(rec: Any, given: Model, augmented: Model, *, cutoff_hz: float | None,
-             backend: str, free_mass: bool) -> dict[str, Any] | None:
+             backend: Any, free_mass: bool) -> dict[str, Any] | None:
     """Whether the given base is far from what the record supports.
 
     Returns None, or ``model`` (the given model, its own effects kept, with the base

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from .. import units as U
-from ..html import plain_text
+from .._words import plain_text
 from ..model import Model
 from ..vocabulary import is_timing
 from .candidates.lag import timing_words

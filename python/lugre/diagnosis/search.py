@@ -11,7 +11,6 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import LugreError
-from ..model import _parse_effect
 from .candidates import Candidate, Context, Term
 from .scoring import (
     _ONE_BLOCK,
@@ -19,15 +18,11 @@ from .scoring import (
     Scorer,
     _one_block,
     accept,
-    accept_many,
-    block_evidence,
     compare,
     rows_of,
-    told_apart,
 )
 
-__all__ = ["accept", "accept_many", "block_evidence", "forward_select", "make_term", "prefetch",
-           "told_apart"]
+__all__ = ["forward_select", "make_term", "prefetch"]
 
 
 def make_term(c: Candidate, h: Any, ctx: Context, *, rows: bool = False) -> Term:
@@ -137,10 +132,10 @@ def _unphysical(c: Candidate, h: Any, beta: np.ndarray, ctx: Context) -> str | N
     """Why the effects a fitted term stands for are no valid model effects, or None
     (the model's own validation: a negative drag coefficient, a dead-band under zero)."""
     try:
-        for e in c.to_effects(h, beta, ctx):
-            _parse_effect(e, "effect")
+        for e in c.to_effects(h, beta, ctx):  # (checked by the core, alone in the model)
+            ctx.model.replace(effects=[e])
     except (LugreError, ValueError) as err:
-        return str(err)
+        return str(err).replace("effects[0].", "effect.")
     return None
 
 

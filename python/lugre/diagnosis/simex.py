@@ -37,7 +37,7 @@ import numpy as np
 from ..io import Recording
 from ..model import Model
 from . import residual as R
-from .search import accept, block_evidence
+from .scoring import accept, block_evidence
 
 __all__ = ["NOISE_SHARE", "SURROGATE_SEED", "gains", "noise_made", "surrogates"]
 

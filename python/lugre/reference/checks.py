@@ -7,7 +7,8 @@ import math
 from typing import Any
 
 from ..exceptions import InputError, ParameterError, _fmt_f64
-from ..model import ModelLike, _as_model, _parse, _Parsed
+from ..model import ModelLike, _as_model
+from .parsed import _parse, _Parsed
 
 __all__: list[str] = []
 

@@ -12,7 +12,7 @@ from .._args import as_array as _array
 from .._args import check_substeps_type as _check_substeps_type
 from .._result import CouplingResult
 from ..exceptions import DataError, ModelError, ParameterError, _fmt_f64
-from ..model import ModelLike, _Friction
+from ..model import ModelLike
 from .checks import (
     _ceil_f,
     _check_finite,
@@ -23,6 +23,7 @@ from .checks import (
     _parsed,
 )
 from .friction import _advance_z, _eval, _eval_shaped
+from .parsed import _Friction
 from .plant import _TwoMass
 
 __all__ = ["load_coupling"]

@@ -34,9 +34,10 @@ from ..exceptions import (
 )
 from ..identify import _dynamic_fit
 from ..io import Recording
-from ..model import Model, ModelLike, _Parsed
+from ..model import Model, ModelLike
 from .checks import _check_finite, _check_time, _parsed
 from .nm import NmOptions, minimize
+from .parsed import _Parsed
 from .robust import Weighting, robust_scale
 from .servo import _simulate
 from .static import _usize

@@ -11,8 +11,9 @@ import numpy as np
 
 from .._args import as_array as _array
 from ..exceptions import InputError, _fmt_f64
-from ..model import ModelLike, _Friction, _StaticSet
+from ..model import ModelLike
 from .checks import _check_finite, _check_len, _check_scale, _finite_option, _parsed
+from .parsed import _Friction, _StaticSet
 
 __all__ = ["friction_force", "stribeck"]
 

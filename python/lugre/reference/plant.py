@@ -7,9 +7,9 @@ from __future__ import annotations
 import math
 from bisect import bisect_right
 
-from ..model import _CurrentLoop, _Parsed
 from .checks import _ceil_f
 from .friction import _advance_z, _eval, _eval_shaped
+from .parsed import _CurrentLoop, _Parsed
 
 __all__: list[str] = []
 

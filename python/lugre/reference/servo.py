@@ -14,9 +14,10 @@ from .._args import check_substeps_type as _check_substeps_type
 from .._args import select_drive as _select_drive
 from .._result import SimResult
 from ..exceptions import DataError, InputError, ModelError, ParameterError, _fmt_f64
-from ..model import ModelLike, _Parsed
+from ..model import ModelLike
 from .checks import _check_finite, _check_len, _check_time, _finite_option, _parsed
 from .friction import _Compensator, _stribeck1
+from .parsed import _Parsed
 from .plant import _Physics, _State, _TwoMass
 
 __all__ = ["simulate", "simulate_batch"]
