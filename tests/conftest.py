@@ -1,8 +1,10 @@
 """Test-wide rules.
 
-In CI (``CI`` set, as ``.ci/run`` does) a test that would skip because its data or the
-headless browser are missing FAILS instead: CI must run every check, and a silent skip
-would hide a broken setup. (The data the tests read is in the repository, tests/data.)
+In CI (``CI`` set, as ``.ci/run`` does) a test that would skip because something CI
+installs is missing (the headless browser, the compiled core as a release build,
+import-linter) FAILS instead: CI must run every check, and a silent skip would hide a
+broken setup. The data the tests read is in the repository (tests/data): no test skips
+for want of it.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ import os
 import pytest
 
 #: Words in a skip reason that mean "something CI must provide is missing".
-_REQUIRED = ("shared", "chromium", "datasets", "EMPS")
+_REQUIRED = ("chromium", "compiled core", "release build", "import-linter")
 
 
 @pytest.hookimpl(hookwrapper=True)

@@ -1,4 +1,4 @@
-"""The rule of tests/conftest.py: in CI a skip for want of ../shared or Chromium fails."""
+"""The rule of tests/conftest.py: in CI a skip for want of what CI installs fails."""
 
 from __future__ import annotations
 
@@ -13,8 +13,8 @@ CONFTEST = (Path(__file__).parent / "conftest.py").read_text()
 SKIPPING = """
 import pytest
 
-def test_needs_shared():
-    pytest.skip("shared datasets not found at ../shared")
+def test_needs_chromium():
+    pytest.skip("no headless chromium found")
 
 def test_optional():
     pytest.skip("pandas is not installed")
@@ -22,7 +22,7 @@ def test_optional():
 
 
 @pytest.mark.parametrize("ci", ["", "1"])
-def test_skips_for_missing_data_fail_in_ci(pytester, monkeypatch, ci):
+def test_skips_for_what_ci_installs_fail_in_ci(pytester, monkeypatch, ci):
     pytester.makeconftest(CONFTEST)
     pytester.makepyfile(SKIPPING)
     if ci:

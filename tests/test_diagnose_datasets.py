@@ -12,9 +12,6 @@ from shared_data import SHARED
 MISMATCH = SHARED / "datasets" / "mismatch"
 EMPS = SHARED / "datasets" / "emps" / "emps_estimation.csv"
 
-pytestmark = pytest.mark.skipif(
-    not MISMATCH.is_dir(), reason=f"shared datasets not found at {SHARED / 'datasets'}"
-)
 
 
 @pytest.mark.parametrize("case", ["none", "cogging", "position_friction", "deadband", "drag",
@@ -67,8 +64,6 @@ def test_mismatch_case(case):
 
 @pytest.fixture(scope="module")
 def emps_laps():
-    if not EMPS.is_file():
-        pytest.skip(f"EMPS record not found at {EMPS}")
     rec = lugre.read_recording(EMPS)
     fit_part, check = rec.slice((None, 12.42)), rec.slice((12.42, None))
     base = fit_inverse_dynamics(fit_part)
@@ -91,7 +86,6 @@ def test_emps_laps(emps_laps):
 PULSES = SHARED / "datasets" / "emps" / "emps_validation_pulses.csv"
 
 
-@pytest.mark.skipif(not PULSES.is_file(), reason=f"EMPS pulses record not found at {PULSES}")
 def test_emps_model_questioned_on_another_session(emps_laps):
     # the augmented model of laps 1-2 keeps every effect on laps 3-4 (recorded right
     # after); on the pulses record, another session, its 2.5 mm cogging sits 0.7 mm

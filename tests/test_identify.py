@@ -14,8 +14,6 @@ import pytest
 from shared_data import SHARED
 
 STATIC = SHARED / "datasets" / "static"
-needs_static = pytest.mark.skipif(not STATIC.is_dir(),
-                                  reason=f"shared datasets not found at {STATIC}")
 
 
 def truth_sets() -> dict[str, dict[str, float]]:
@@ -53,7 +51,6 @@ def test_static_many_points_match_the_starts_on_every_point():
         np.testing.assert_array_equal(getattr(at, d).weights, getattr(every, d).weights)
 
 
-@needs_static
 def test_static_points_with_gross_errors():
     """paper_axis_points.csv (about 12 % gross errors): fc, fs, sigma2 within 1 % and vs
     within 1.5 % of the truth (plain least squares on the clean points alone misses vs by
@@ -104,7 +101,6 @@ def test_static_direction_with_half_gross_errors():
     assert good >= 14, good
 
 
-@needs_static
 def test_static_from_raw_plateaus():
     """The raw plateau record: plateaus found, creeping ones skipped and said so, fc and
     sigma2 within 1 %."""
@@ -216,7 +212,6 @@ def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
                           text=True, timeout=600)
 
 
-@needs_static
 def test_cli_fit_static_and_refusal_to_overwrite(tmp_path):
     out = tmp_path / "static.json"
     png = tmp_path / "static.png"
@@ -249,7 +244,6 @@ def test_cli_fit_dynamic(tmp_path):
 EMPS = SHARED / "datasets" / "emps" / "emps_estimation.csv"
 
 
-@pytest.mark.skipif(not EMPS.is_file(), reason=f"EMPS data not found at {EMPS}")
 def test_cli_fit_on_real_emps_data(tmp_path):
     """Real measurements: the general fit finds the benchmark's mass (95.1 kg by IDIM-LS)
     and a force error below the benchmark's per-direction model (3.11 %). The record has

@@ -82,8 +82,6 @@ def test_kernels_twins(pair, case):
 def test_kernels_twins_on_independent_plant():
     """A record written by the independent plant of ../shared (a resonance case)."""
     case = MISMATCH / "resonance"
-    if not case.is_dir():
-        pytest.skip(f"shared datasets not found at {MISMATCH}")
     rec = lugre.read_recording(case / "recording.csv")
     model = lugre.load_model(case / "model.json")
     n = 3000

@@ -45,7 +45,7 @@ def test_the_diagnosis_runs_without_the_twin():
     assert out.stdout.strip() == "False"
 
 
-@pytest.mark.skipif(shutil.which("lint-imports") is None, reason="import-linter not installed")
+@pytest.mark.skipif(shutil.which("lint-imports") is None, reason="import-linter is not installed")
 def test_import_contracts_hold():
     out = subprocess.run(["lint-imports", "--no-cache"], capture_output=True, text=True,
                          check=False, cwd=ROOT, env=_env())

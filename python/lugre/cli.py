@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from .exceptions import InputError, LugreError
+from .vocabulary import CURRENT_LAG, DELAY
 
 __all__ = ["main"]
 
@@ -414,7 +415,7 @@ def _print_fit(fit: Any, effects: list[str]) -> None:
                                                if isinstance(v, float)))
         got = {f.effect for f in dg.findings}
         for e in effects:
-            if e in got or (e in ("delay", "current_lag") and {"delay", "current_lag"} & got):
+            if e in got or (e in (DELAY, CURRENT_LAG) and {DELAY, CURRENT_LAG} & got):
                 continue
             print(f"{e}: not supported by this record (no consistent gain on held-out "
                   "stretches); left out of the model", file=sys.stderr)

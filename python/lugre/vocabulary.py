@@ -11,8 +11,25 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["EFFECTS", "MASS_EFFECTS", "NAMES", "ONE_OF_A_KIND", "TIMING", "TIMING_FORMS", "Effect", "Parameter", "held_kinds",
-           "is_timing", "kind"]
+__all__ = ["COGGING", "CURRENT_LAG", "DEADBAND", "DELAY", "DRAG", "DRIFT", "EFFECTS", "MASS",
+           "MASS_EFFECTS", "NAMES", "OFFSET", "ONE_OF_A_KIND", "POSITION_FRICTION", "RESONANCE",
+           "SPRING", "STRIBECK_SHAPE", "TIMING", "TIMING_FORMS", "Effect", "Parameter",
+           "held_kinds", "is_timing", "kind"]
+
+
+#: The effect names, each spelled here once; everything else takes them from here.
+COGGING = "cogging"
+SPRING = "spring"
+OFFSET = "offset"
+POSITION_FRICTION = "position_friction"
+DRIFT = "drift"
+MASS = "mass"
+DELAY = "delay"
+CURRENT_LAG = "current_lag"
+RESONANCE = "resonance"
+DEADBAND = "deadband"
+DRAG = "drag"
+STRIBECK_SHAPE = "stribeck_shape"
 
 
 @dataclass(frozen=True)
@@ -78,40 +95,40 @@ class Effect:
 
 
 #: The kind of both timing forms.
-TIMING = "delay"
+TIMING = DELAY
 
 _TIMING_EXPERIMENT = "fast reversals or a current chirp up to a few hundred Hz"
 
 #: The vocabulary, in the order of the CONTRACT (and of the core's ``EFFECT_NAMES``).
 EFFECTS: dict[str, Effect] = {e.name: e for e in (
-    Effect("cogging", (Parameter("amplitude", "N"), _m("pitch"), Parameter("phase", "rad")),
+    Effect(COGGING, (Parameter("amplitude", "N"), _m("pitch"), Parameter("phase", "rad")),
            "a slow constant-speed move over at least three pitches in each direction", "x"),
-    Effect("spring", (Parameter("stiffness", "N/m"), _m("x0")),
+    Effect(SPRING, (Parameter("stiffness", "N/m"), _m("x0")),
            "slow moves across the whole stroke in both directions", "x"),
-    Effect("offset", (Parameter("force", "N"),),
+    Effect(OFFSET, (Parameter("force", "N"),),
            "constant-speed moves in both directions at the same speed", "v",
            additive="force"),
-    Effect("position_friction", (_m("positions"), Parameter("scale", "")),
+    Effect(POSITION_FRICTION, (_m("positions"), Parameter("scale", "")),
            "slow constant-speed moves over the whole stroke in both directions", "x"),
-    Effect("drift", (Parameter("gain", ""), Parameter("time_constant", "s")),
+    Effect(DRIFT, (Parameter("gain", ""), Parameter("time_constant", "s")),
            "a recording from a cold start lasting several time constants", "t"),
-    Effect("mass", (Parameter("delta", "kg"),),
+    Effect(MASS, (Parameter("delta", "kg"),),
            "fast back-and-forth moves (large accelerations)", "t", additive="delta",
            adds_mass=True),
     Effect(TIMING, (Parameter("seconds", "s", "ms", 1e3),), _TIMING_EXPERIMENT, "t",
            one_of_a_kind=True, derived=(Parameter("bandwidth", "Hz"),)),
-    Effect("current_lag", (Parameter("bandwidth", "Hz"),), _TIMING_EXPERIMENT, "t",
+    Effect(CURRENT_LAG, (Parameter("bandwidth", "Hz"),), _TIMING_EXPERIMENT, "t",
            kind=TIMING, one_of_a_kind=True,
            derived=(Parameter("seconds", "s", "ms", 1e3),)),
-    Effect("resonance", (Parameter("frequency", "Hz"), Parameter("damping_ratio", ""),
+    Effect(RESONANCE, (Parameter("frequency", "Hz"), Parameter("damping_ratio", ""),
                          Parameter("load_fraction", "")),
            "a chirp of the position reference through the suspected frequency band", "t",
            one_of_a_kind=True),
-    Effect("deadband", (Parameter("current", "A"),),
+    Effect(DEADBAND, (Parameter("current", "A"),),
            "very slow moves that cross zero current", "v"),
-    Effect("drag", (Parameter("coefficient", "N s^2/m^2", "N s²/m²"),),
+    Effect(DRAG, (Parameter("coefficient", "N s^2/m^2", "N s²/m²"),),
            "constant-speed moves at several high speeds", "v", additive="coefficient"),
-    Effect("stribeck_shape", (Parameter("exponent", ""),),
+    Effect(STRIBECK_SHAPE, (Parameter("exponent", ""),),
            "slow feeds at speeds from a tenth to ten times the Stribeck velocity", "v",
            one_of_a_kind=True),
 )}

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..model import Model
-from ..vocabulary import ONE_OF_A_KIND, kind
+from ..vocabulary import CURRENT_LAG, ONE_OF_A_KIND, kind
 from . import base as B
 from . import evidence as V
 from . import residual as R
@@ -106,7 +106,7 @@ def _differs(old: dict[str, Any], new: dict[str, Any]) -> bool:
     in its effective delay."""
     shared = [k for k, v in new.items()
               if isinstance(v, (int, float)) and isinstance(old.get(k), (int, float))]
-    if old.get("effect") == "current_lag" and "seconds" not in old:
+    if old.get("effect") == CURRENT_LAG and "seconds" not in old:
         shared = []  # a lag given by its bandwidth: compared by its mean delay below
     if shared:
         return any(_far(new[k], old[k]) for k in shared)

@@ -16,22 +16,32 @@ import numpy as np
 from .._native import simulate
 from ..io import Recording
 from ..model import Model
+from ..vocabulary import (
+    COGGING,
+    CURRENT_LAG,
+    DELAY,
+    DRIFT,
+    MASS,
+    OFFSET,
+    POSITION_FRICTION,
+    SPRING,
+)
 
 __all__ = ["EFFECTS", "axis_model", "case", "concealed", "reference_trajectory", "trajectory"]
 
 #: A default concealed instance of every effect of the vocabulary.
 EFFECTS: dict[str, dict[str, Any] | None] = {
     "none": None,
-    "cogging": {"effect": "cogging", "amplitude": 2.5, "pitch": 0.03, "phase": 0.7},
-    "spring": {"effect": "spring", "stiffness": 40.0, "x0": -0.05},
-    "offset": {"effect": "offset", "force": 3.0},
-    "position_friction": {"effect": "position_friction",
+    COGGING: {"effect": COGGING, "amplitude": 2.5, "pitch": 0.03, "phase": 0.7},
+    SPRING: {"effect": SPRING, "stiffness": 40.0, "x0": -0.05},
+    OFFSET: {"effect": OFFSET, "force": 3.0},
+    POSITION_FRICTION: {"effect": POSITION_FRICTION,
                           "positions": [-0.1, -0.06, -0.03, 0.0, 0.1],
                           "scale": [1.0, 1.0, 1.3, 1.0, 1.0]},
-    "drift": {"effect": "drift", "gain": 0.15, "time_constant": 3.0},  # well inside a 10 s record
-    "mass": {"effect": "mass", "delta": 5.0},
-    "delay": {"effect": "delay", "seconds": 0.002},
-    "current_lag": {"effect": "current_lag", "bandwidth": 60.0},
+    DRIFT: {"effect": DRIFT, "gain": 0.15, "time_constant": 3.0},  # well inside a 10 s record
+    MASS: {"effect": MASS, "delta": 5.0},
+    DELAY: {"effect": DELAY, "seconds": 0.002},
+    CURRENT_LAG: {"effect": CURRENT_LAG, "bandwidth": 60.0},
 }
 
 

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..model import Model
+from ..vocabulary import CURRENT_LAG, DELAY
 from . import candidates as E
 from . import residual as R
 from .candidates import Term
@@ -67,7 +68,7 @@ def choose_timing(model: Model, sig: R.Signals, terms: list[Term], k: int,
     separates them.
     """
     fits = {}
-    for form in ("delay", "current_lag"):
+    for form in (DELAY, CURRENT_LAG):
         tt = list(terms)
         tt[k] = Term(cand=terms[k].cand, h=form, X=terms[k].X)
         out = refine(model, sig, tt, dict(base), [b.copy() for b in betas], s2, names,
@@ -75,10 +76,10 @@ def choose_timing(model: Model, sig: R.Signals, terms: list[Term], k: int,
         fits[form] = (*out, R.residual(out[0], sig))
     sse = {f: np.array([np.sum(v[5][sig.mask][b] ** 2) for b in blocks])
            for f, v in fits.items()}
-    dd = (sse["delay"] - sse["current_lag"]) / s2
+    dd = (sse[DELAY] - sse[CURRENT_LAG]) / s2
     # the lag also smooths the measurement noise of the recorded current, which a
     # delay passes unchanged: that much of its advantage says nothing about the drive
-    lag = next(e for e in fits["current_lag"][0].effects if e["effect"] == "current_lag")
+    lag = next(e for e in fits[CURRENT_LAG][0].effects if e["effect"] == CURRENT_LAG)
     n_b = sum(b.stop - b.start for b in blocks)
     noise_gain = smoothing_gain(sig, float(lag["bandwidth"]), n_b, s2)
     dd = dd - noise_gain / len(blocks)
@@ -87,8 +88,8 @@ def choose_timing(model: Model, sig: R.Signals, terms: list[Term], k: int,
     separated, _ = told_apart(dd, min_gain)
     # not separated: the record shows a time shift and nothing of the attenuation a lag
     # would add, so the pure delay is named and the lag given beside it
-    better = "current_lag" if separated and dd.sum() > 0 else "delay"
-    other = "delay" if better == "current_lag" else "current_lag"
+    better = CURRENT_LAG if separated and dd.sum() > 0 else DELAY
+    other = DELAY if better == CURRENT_LAG else CURRENT_LAG
     aug, base_f, betas_f, ctx, terms_f, _ = fits[better]
     alt = None
     if not separated:

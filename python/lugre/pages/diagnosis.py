@@ -10,7 +10,7 @@ from typing import Any
 
 from .. import units as U
 from .._words import plain_text
-from ..vocabulary import EFFECTS
+from ..vocabulary import CURRENT_LAG, DELAY, EFFECTS
 from .frame import _COLOURS, _figure, _p, _page, _safe_figure, _table
 
 __all__ = ["EXPERIMENTS", "diagnosis_page"]
@@ -45,7 +45,7 @@ def _list_summary(name: str, vals: list[float], unit: tuple[str, float],
     if name == "scale" and isinstance(pos, (list, tuple)) and len(pos) == len(vals):
         k = max(range(len(vals)), key=lambda j: abs(vals[j] - 1.0))
         text += (f"; largest change ×{U.num(vals[k])} at "
-                 f"{U.fmt(pos[k], U.EFFECT_UNITS['position_friction']['positions'])}")
+                 f"{U.fmt(pos[k], U.POSITION)}")
     return text
 
 
@@ -76,9 +76,9 @@ def _param_rows(effect: str, params: dict[str, Any], unc: dict[str, Any]) -> lis
 
 
 # a timing finding carries both of its readings (lugre.diagnosis.timing.timing_parameters)
-_TIMING_LABELS = {("delay", "seconds"): "effective delay",
-                  ("delay", "bandwidth"): "or, as a current lag, its bandwidth",
-                  ("current_lag", "seconds"): "effective delay"}
+_TIMING_LABELS = {(DELAY, "seconds"): "effective delay",
+                  (DELAY, "bandwidth"): "or, as a current lag, its bandwidth",
+                  (CURRENT_LAG, "seconds"): "effective delay"}
 
 
 def _is_num(x: Any) -> bool:

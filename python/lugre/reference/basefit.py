@@ -12,6 +12,7 @@ import numpy as np
 
 from ..exceptions import DataError, InputError
 from ..model import Model, _as_model
+from ..vocabulary import MASS
 from .robust import Weighting, robust_scale
 
 __all__ = ["fit_base"]
@@ -72,7 +73,7 @@ def _scale_of(p: tuple[str | None, str], doc: dict[str, Any], vmax: float) -> fl
 
 def _total_mass(doc: dict[str, Any]) -> float:
     return float(doc["axis"]["mass"]) + sum(float(e.get("delta", 0.0)) for e in doc["effects"]
-                                           if e.get("effect") == "mass")
+                                           if e.get("effect") == MASS)
 
 
 def _loss(w: Weighting, u: np.ndarray) -> np.ndarray:

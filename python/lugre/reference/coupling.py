@@ -13,6 +13,7 @@ from .._args import check_substeps_type as _check_substeps_type
 from .._result import CouplingResult
 from ..exceptions import DataError, ModelError, ParameterError, _fmt_f64
 from ..model import ModelLike
+from ..vocabulary import RESONANCE
 from .checks import (
     _ceil_f,
     _check_finite,
@@ -105,7 +106,7 @@ def load_coupling(
     ex = None if extra is None else _array("extra", extra).tolist()
     dtf = _finite_option_any("dt", dt)
     _check_substeps_type(substeps)
-    res = next((e.params for e in parsed.effects if e.kind == "resonance"), None)
+    res = next((e.params for e in parsed.effects if e.kind == RESONANCE), None)
     if res is None:
         raise ModelError.at(
             "effects",

@@ -19,6 +19,19 @@ from .._args import as_array as _array
 from .._args import frequency_count
 from ..exceptions import InputError, ParameterError, _fmt_f64
 from ..model import ModelLike, _as_model
+from ..vocabulary import (
+    COGGING,
+    CURRENT_LAG,
+    DEADBAND,
+    DELAY,
+    DRAG,
+    DRIFT,
+    OFFSET,
+    POSITION_FRICTION,
+    RESONANCE,
+    SPRING,
+    STRIBECK_SHAPE,
+)
 
 __all__ = ["COUPLING_SUBSTEPS", "InverseRecord", "parse_base_param",
            "position_sums"]
@@ -234,9 +247,9 @@ class InverseRecord:
         s = None
         for e in m.effects:
             k = e["effect"]
-            if k == "position_friction":
+            if k == POSITION_FRICTION:
                 f = _interp(self.x, e["positions"], e["scale"])
-            elif k == "drift":
+            elif k == DRIFT:
                 f = 1.0 - e["gain"] * (1.0 - np.exp(-self.t / e["time_constant"]))
             else:
                 continue
@@ -246,7 +259,7 @@ class InverseRecord:
     @staticmethod
     def _exponent(m: Any) -> float | None:
         for e in m.effects:
-            if e["effect"] == "stribeck_shape":
+            if e["effect"] == STRIBECK_SHAPE:
                 ex = float(e["exponent"])
                 return None if ex == 2.0 else ex
         return None
@@ -300,16 +313,16 @@ class InverseRecord:
         x, v = self.x, self.v
         for e in m.effects:
             k = e["effect"]
-            if k == "cogging":
+            if k == COGGING:
                 w = 2.0 * math.pi / e["pitch"]
                 out += e["amplitude"] * np.sin(w * x + e.get("phase", 0.0))
                 for j, (amp, ph) in enumerate(e.get("harmonics", []) or []):
                     out += amp * np.sin(float(j + 2) * w * x + ph)
-            elif k == "spring":
+            elif k == SPRING:
                 out += e["stiffness"] * (x - e.get("x0", 0.0))
-            elif k == "offset":
+            elif k == OFFSET:
                 out += e["force"]
-            elif k == "drag":
+            elif k == DRAG:
                 out += e["coefficient"] * np.abs(v) * v
         return out
 
@@ -325,7 +338,7 @@ class InverseRecord:
         """Filtered force the model needs besides the motor."""
         m = _as_model(model)
         mass = m.total_mass
-        res = next((e for e in m.effects if e["effect"] == "resonance"), None)
+        res = next((e for e in m.effects if e["effect"] == RESONANCE), None)
         if res is None:
             f = self.base_friction(m) + self.effect_force(m)
             return mass * self.a + self.filt(f)
@@ -338,11 +351,11 @@ class InverseRecord:
         delay = band = lag = None
         for e in m.effects:
             k = e["effect"]
-            if k == "delay" and e["seconds"] > 0:
+            if k == DELAY and e["seconds"] > 0:
                 delay = float(e["seconds"])
-            elif k == "deadband" and e["current"] > 0:
+            elif k == DEADBAND and e["current"] > 0:
                 band = float(e["current"]) * m.force_constant
-            elif k == "current_lag":
+            elif k == CURRENT_LAG:
                 lag = float(e["bandwidth"])
         if delay is None and band is None and lag is None:
             return self.fm_f.copy()

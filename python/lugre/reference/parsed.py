@@ -12,7 +12,21 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..exceptions import ModelError, ParameterError
-from ..vocabulary import NAMES
+from ..vocabulary import (
+    COGGING,
+    CURRENT_LAG,
+    DEADBAND,
+    DELAY,
+    DRAG,
+    DRIFT,
+    MASS,
+    NAMES,
+    OFFSET,
+    POSITION_FRICTION,
+    RESONANCE,
+    SPRING,
+    STRIBECK_SHAPE,
+)
 
 __all__: list[str] = []
 
@@ -102,14 +116,14 @@ class _Parsed:
 
     @property
     def total_mass(self) -> float:
-        dm = sum(e.params["delta"] for e in self.effects if e.kind == "mass")
+        dm = sum(e.params["delta"] for e in self.effects if e.kind == MASS)
         return self.axis.mass + dm
 
     @property
     def stribeck_exponent(self) -> float | None:
         """Exponent of a ``stribeck_shape`` effect, ``None`` without one."""
         for e in self.effects:
-            if e.kind == "stribeck_shape":
+            if e.kind == STRIBECK_SHAPE:
                 return float(e.params["exponent"])
         return None
 
@@ -247,7 +261,7 @@ def _parse_effect(e: Any, path: str) -> _Effect:
     def p(k: str) -> str:
         return _join(path, k)
 
-    if kind == "cogging":
+    if kind == COGGING:
         harmonics: list[tuple[float, float]] = []
         h = e.get("harmonics")
         if h is not None:
@@ -266,13 +280,13 @@ def _parse_effect(e: Any, path: str) -> _Effect:
             "amplitude": amplitude, "pitch": pitch,
             "phase": 0.0 if phase is None else phase, "harmonics": tuple(harmonics),
         })
-    if kind == "spring":
+    if kind == SPRING:
         stiffness = n("stiffness")
         x0 = _opt_num(e, "x0", path)
         return _Effect(kind, {"stiffness": stiffness, "x0": 0.0 if x0 is None else x0})
-    if kind == "offset":
+    if kind == OFFSET:
         return _Effect(kind, {"force": n("force")})
-    if kind == "position_friction":
+    if kind == POSITION_FRICTION:
         positions = _num_list(_get(e, "positions", path), p("positions"))
         scale = _num_list(_get(e, "scale", path), p("scale"))
         if not positions or len(positions) != len(scale):
@@ -289,7 +303,7 @@ def _parse_effect(e: Any, path: str) -> _Effect:
         for k, s in enumerate(scale):
             _positive(s, f"{p('scale')}[{k}]")
         return _Effect(kind, {"positions": tuple(positions), "scale": tuple(scale)})
-    if kind == "drift":
+    if kind == DRIFT:
         gain = n("gain")
         if gain >= 1.0:
             raise ParameterError.invalid(
@@ -297,13 +311,13 @@ def _parse_effect(e: Any, path: str) -> _Effect:
             )
         tc = _positive(n("time_constant"), p("time_constant"))
         return _Effect(kind, {"gain": gain, "time_constant": tc})
-    if kind == "mass":
+    if kind == MASS:
         return _Effect(kind, {"delta": n("delta")})
-    if kind == "delay":
+    if kind == DELAY:
         return _Effect(kind, {"seconds": _nonneg(n("seconds"), p("seconds"))})
-    if kind == "current_lag":
+    if kind == CURRENT_LAG:
         return _Effect(kind, {"bandwidth_hz": _positive(n("bandwidth"), p("bandwidth"))})
-    if kind == "resonance":
+    if kind == RESONANCE:
         frequency = _positive(n("frequency"), p("frequency"))
         zeta = _nonneg(n("damping_ratio"), p("damping_ratio"))
         r = n("load_fraction")
@@ -314,11 +328,11 @@ def _parse_effect(e: Any, path: str) -> _Effect:
             )
         return _Effect(kind, {"frequency_hz": frequency, "damping_ratio": zeta,
                               "load_fraction": r})
-    if kind == "deadband":
+    if kind == DEADBAND:
         return _Effect(kind, {"current": _nonneg(n("current"), p("current"))})
-    if kind == "drag":
+    if kind == DRAG:
         return _Effect(kind, {"coefficient": _nonneg(n("coefficient"), p("coefficient"))})
-    if kind == "stribeck_shape":
+    if kind == STRIBECK_SHAPE:
         return _Effect(kind, {"exponent": _positive(n("exponent"), p("exponent"))})
     raise ModelError.at(p("effect"), f'unknown effect "{kind}": use one of {_EFFECTS}')
 
@@ -413,19 +427,19 @@ def _parse_effects(v: Mapping[str, Any], mass: float) -> tuple[_Effect, ...]:
         if not isinstance(ev, (list, tuple)):
             raise ModelError.at("effects", "must be a list")
         effects = [_parse_effect(x, f"effects[{k}]") for k, x in enumerate(ev)]
-    n_delay = sum(e.kind == "delay" for e in effects)
-    n_lag = sum(e.kind == "current_lag" for e in effects)
+    n_delay = sum(e.kind == DELAY for e in effects)
+    n_lag = sum(e.kind == CURRENT_LAG for e in effects)
     if n_delay > 1 or n_lag > 1:
         raise ModelError.at(
             "effects", "holds more than one delay or current_lag: merge them into one"
         )
-    n_res = sum(e.kind == "resonance" for e in effects)
-    n_shape = sum(e.kind == "stribeck_shape" for e in effects)
+    n_res = sum(e.kind == RESONANCE for e in effects)
+    n_shape = sum(e.kind == STRIBECK_SHAPE for e in effects)
     if n_res > 1 or n_shape > 1:
         raise ModelError.at(
             "effects", "holds more than one resonance or stribeck_shape: keep one of each"
         )
-    dm = sum(e.params["delta"] for e in effects if e.kind == "mass")
+    dm = sum(e.params["delta"] for e in effects if e.kind == MASS)
     if mass + dm <= 0.0:
         raise ParameterError.invalid(
             "effects.mass.delta", float(dm), "makes the total mass zero or negative"

@@ -7,6 +7,19 @@ from __future__ import annotations
 import math
 from bisect import bisect_right
 
+from ..vocabulary import (
+    COGGING,
+    CURRENT_LAG,
+    DEADBAND,
+    DELAY,
+    DRAG,
+    DRIFT,
+    OFFSET,
+    POSITION_FRICTION,
+    RESONANCE,
+    SPRING,
+    STRIBECK_SHAPE,
+)
 from .checks import _ceil_f
 from .friction import _advance_z, _eval, _eval_shaped
 from .parsed import _CurrentLoop, _Parsed
@@ -77,32 +90,32 @@ class _Physics:
         self.res: _TwoMass | None = None
         for e in m.effects:
             q = e.params
-            if e.kind == "cogging":
+            if e.kind == COGGING:
                 w = 2.0 * _PI / q["pitch"]
                 self.cogging.append((q["amplitude"], w, q["phase"]))
                 for k, (a, ph) in enumerate(q["harmonics"]):
                     self.cogging.append((a, w * (k + 2.0), ph))
-            elif e.kind == "spring":
+            elif e.kind == SPRING:
                 self.lin_a += q["stiffness"]
                 self.lin_b -= q["stiffness"] * q["x0"]
-            elif e.kind == "offset":
+            elif e.kind == OFFSET:
                 self.lin_b += q["force"]
-            elif e.kind == "position_friction":
+            elif e.kind == POSITION_FRICTION:
                 self.pos_scale.append((q["positions"], q["scale"]))
-            elif e.kind == "drift":
+            elif e.kind == DRIFT:
                 self.drift.append((q["gain"], q["time_constant"]))
-            elif e.kind == "delay":
+            elif e.kind == DELAY:
                 self.delay = q["seconds"]
-            elif e.kind == "current_lag":
+            elif e.kind == CURRENT_LAG:
                 self.lag_w = 2.0 * _PI * q["bandwidth_hz"]
-            elif e.kind == "resonance":
+            elif e.kind == RESONANCE:
                 self.res = _TwoMass(self.mass, q["frequency_hz"], q["damping_ratio"],
                                     q["load_fraction"])
-            elif e.kind == "deadband":
+            elif e.kind == DEADBAND:
                 self.deadband = q["current"]
-            elif e.kind == "drag":
+            elif e.kind == DRAG:
                 self.drag += q["coefficient"]
-            elif e.kind == "stribeck_shape":
+            elif e.kind == STRIBECK_SHAPE:
                 self.shape = q["exponent"]
         self.has_scale = bool(self.pos_scale) or bool(self.drift)
 

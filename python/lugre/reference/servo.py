@@ -15,6 +15,7 @@ from .._args import select_drive as _select_drive
 from .._result import SimResult
 from ..exceptions import DataError, InputError, ModelError, ParameterError, _fmt_f64
 from ..model import ModelLike
+from ..vocabulary import RESONANCE
 from .checks import _check_finite, _check_len, _check_time, _finite_option, _parsed
 from .friction import _Compensator, _stribeck1
 from .parsed import _Parsed
@@ -198,7 +199,7 @@ def _check_resonance_step(m: _Parsed, open_loop: bool, tl: list[float], substeps
     """The core's ``check_resonance_step``: plant steps short enough for the free
     motor-load mode of a resonance."""
     for e in m.effects:
-        if e.kind == "resonance":
+        if e.kind == RESONANCE:
             q = e.params
             tm = _TwoMass(m.total_mass, q["frequency_hz"], q["damping_ratio"],
                           q["load_fraction"])

@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from ...vocabulary import DRIFT
 from .base import Candidate, Context, FindingView, Said
 from .probe import hide, share, under
 
@@ -13,7 +14,7 @@ __all__ = ["Drift"]
 
 
 class Drift(Candidate):
-    effect = "drift"
+    effect = DRIFT
     signature = ("a trend in time of the Coulomb/static friction level (its sign follows "
                  "the direction of motion)")
 
@@ -37,7 +38,7 @@ class Drift(Candidate):
         return ctx.sig.filt(self._col(h, ctx))[:, None]
 
     def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
-        return [{"effect": "drift", "gain": float(min(-beta[0], 0.95)),
+        return [{"effect": DRIFT, "gain": float(min(-beta[0], 0.95)),
                  "time_constant": float(h)}]
 
     def where(self, h: Any, beta: np.ndarray, ctx: Context) -> dict[str, Any]:

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from ...vocabulary import CURRENT_LAG, DELAY
 from ..residual import Signals
 from .base import Candidate, Context, FindingView, Said, Term
 from .linear import Mass
@@ -26,7 +27,7 @@ class Lag(Candidate):
     """``delay`` and ``current_lag``: the same first-order signature, told apart later
     (:mod:`lugre.diagnosis.timing`)."""
 
-    effect = "delay"
+    effect = DELAY
     signature = ("the motor force arrives late: the residual follows the rate of change of "
                  "the motor force")
 
@@ -35,9 +36,9 @@ class Lag(Candidate):
 
     def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
         tau = float(beta[0])
-        if h == "current_lag":
-            return [{"effect": "current_lag", "bandwidth": 1.0 / (2 * math.pi * max(tau, 1e-9))}]
-        return [{"effect": "delay", "seconds": max(tau, 0.0)}]
+        if h == CURRENT_LAG:
+            return [{"effect": CURRENT_LAG, "bandwidth": 1.0 / (2 * math.pi * max(tau, 1e-9))}]
+        return [{"effect": DELAY, "seconds": max(tau, 0.0)}]
 
     def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
         tau = float(beta[0])
@@ -138,7 +139,7 @@ def lag_at_reversals(scorer: Any, terms: list[Any], k: int, ev: Any,
 
 def effective_delay(effect: dict[str, Any]) -> float:
     """Mean delay [s] of the force behind the recorded current for a timing effect."""
-    if effect["effect"] == "delay":
+    if effect["effect"] == DELAY:
         return float(effect["seconds"])
     return 1.0 / (2.0 * math.pi * float(effect["bandwidth"]))
 
@@ -153,10 +154,10 @@ def timing_parameters(effect: dict[str, Any],
     bandwidth is the one given). The augmented model holds the named form only.
     """
     out = {"seconds": effective_delay(effect)}
-    if effect["effect"] == "current_lag":
+    if effect["effect"] == CURRENT_LAG:
         out["bandwidth"] = float(effect["bandwidth"])
     else:
-        lag = next((a for a in alternatives if a.get("effect") == "current_lag"), None)
+        lag = next((a for a in alternatives if a.get("effect") == CURRENT_LAG), None)
         if lag is not None:
             out["bandwidth"] = float(lag["parameters"]["bandwidth"])
     return out
@@ -168,7 +169,7 @@ def timing_words(effect: str, parameters: dict[str, Any]) -> str:
     sec = parameters.get("seconds")
     bw = parameters.get("bandwidth")
     d = f"effective delay {sec * 1e3:.3g} ms" if isinstance(sec, (int, float)) else ""
-    if effect == "current_lag" and isinstance(bw, (int, float)):
+    if effect == CURRENT_LAG and isinstance(bw, (int, float)):
         return f"bandwidth {bw:.3g} Hz" + (f", {d}" if d else "")
     if isinstance(bw, (int, float)):
         return d + f", or a current lag of {bw:.3g} Hz"

@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from ...vocabulary import DRAG, MASS, OFFSET, SPRING
 from .. import base as B
 from .. import residual as R
 from .base import Candidate, Context, FindingView, Said, by
@@ -36,14 +37,14 @@ _OFFSET_LEVELS = {"positive.fc": 1.0, "positive.fs": 1.0, "negative.fc": -1.0,
 
 
 class Offset(Candidate):
-    effect = "offset"
+    effect = OFFSET
     signature = "a constant force, the same in both directions of motion and at rest"
 
     def columns(self, h: Any, ctx: Context) -> np.ndarray:
         return np.ones((len(ctx.sig), 1))
 
     def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
-        return [{"effect": "offset", "force": float(beta[0])}]
+        return [{"effect": OFFSET, "force": float(beta[0])}]
 
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
         b = float(sizes([np.ones(len(ctx.sig))])[0])
@@ -59,8 +60,8 @@ class Offset(Candidate):
 
 
 class Spring(Candidate):
-    effect = "spring"
-    supersedes = ("offset",)
+    effect = SPRING
+    supersedes = (OFFSET,)
     signature = "a force linear in position, the same in both directions"
 
     def columns(self, h: Any, ctx: Context) -> np.ndarray:
@@ -70,11 +71,11 @@ class Spring(Candidate):
     def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
         xm = 0.5 * (ctx.xrange[0] + ctx.xrange[1])
         k = float(beta[0])
-        out = [{"effect": "spring", "stiffness": k, "x0": xm}]
+        out = [{"effect": SPRING, "stiffness": k, "x0": xm}]
         if abs(k) * (ctx.xrange[1] - ctx.xrange[0]) > 1e-9 and abs(beta[1]) < 1e3 * abs(k):
             out[0]["x0"] = float(xm - beta[1] / k)
         else:
-            out.append({"effect": "offset", "force": float(beta[1])})
+            out.append({"effect": OFFSET, "force": float(beta[1])})
         return out
 
     def where(self, h: Any, beta: np.ndarray, ctx: Context) -> dict[str, Any]:
@@ -91,7 +92,7 @@ class Spring(Candidate):
 
 
 class Mass(Candidate):
-    effect = "mass"
+    effect = MASS
     minor_when_consistent = True
     signature = "a force proportional to the acceleration"
 
@@ -99,7 +100,7 @@ class Mass(Candidate):
         return ctx.sig.a[:, None].copy()
 
     def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
-        return [{"effect": "mass", "delta": float(beta[0])}]
+        return [{"effect": MASS, "delta": float(beta[0])}]
 
     check_rank = 1
 
@@ -125,7 +126,7 @@ class Mass(Candidate):
 
 
 class Drag(Candidate):
-    effect = "drag"
+    effect = DRAG
     signature = ("a force growing with the square of the speed, opposing the motion "
                  "(seals, churning lubricant)")
 
@@ -134,7 +135,7 @@ class Drag(Candidate):
         return ctx.sig.filt(np.abs(v) * v)[:, None]
 
     def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
-        return [{"effect": "drag", "coefficient": float(beta[0])}]
+        return [{"effect": DRAG, "coefficient": float(beta[0])}]
 
     def where(self, h: Any, beta: np.ndarray, ctx: Context) -> dict[str, Any]:
         vm = float(np.max(np.abs(ctx.sig.vf[ctx.sig.mask])))

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from ...vocabulary import COGGING, POSITION_FRICTION
 from ..residual import position_sums
 from .base import Candidate, Context, by
 from .probe import hide, share, under
@@ -15,7 +16,7 @@ __all__ = ["Cogging", "PositionFriction"]
 
 
 class Cogging(Candidate):
-    effect = "cogging"
+    effect = COGGING
     chooses = True
     signature = "a force periodic in position, independent of the direction of motion"
 
@@ -92,7 +93,7 @@ class Cogging(Candidate):
     def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
         amp = float(math.hypot(beta[0], beta[1]))
         phase = float(math.atan2(beta[1], beta[0]))
-        return [{"effect": "cogging", "amplitude": amp, "pitch": float(h), "phase": phase}]
+        return [{"effect": COGGING, "amplitude": amp, "pitch": float(h), "phase": phase}]
 
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
         sig = ctx.sig
@@ -120,7 +121,7 @@ class Cogging(Candidate):
 
 
 class PositionFriction(Candidate):
-    effect = "position_friction"
+    effect = POSITION_FRICTION
     scales_levels = True
     signature = ("a change of the Coulomb/static friction level along the guideway: it "
                  "changes sign with the direction of motion and depends on position")
@@ -143,7 +144,7 @@ class PositionFriction(Candidate):
     def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
         kn = self.knots(ctx)
         scale = np.maximum(1.0 + np.asarray(beta, float), 0.05)
-        return [{"effect": "position_friction", "positions": [float(p) for p in kn],
+        return [{"effect": POSITION_FRICTION, "positions": [float(p) for p in kn],
                  "scale": [float(s) for s in scale]}]
 
     def where(self, h: Any, beta: np.ndarray, ctx: Context) -> dict[str, Any]:

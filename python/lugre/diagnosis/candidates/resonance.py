@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from ...vocabulary import RESONANCE
 from .base import Context, grid_interval, objects
 from .probe import hide
 from .secant import _Secant
@@ -14,7 +15,7 @@ __all__ = ["Resonance"]
 
 
 class Resonance(_Secant):
-    effect = "resonance"
+    effect = RESONANCE
     signature = ("a compliant coupling: the load the encoder does not see swings against "
                  "the motor at the coupling's natural frequency")
     smooths_readings = True
@@ -88,7 +89,7 @@ class Resonance(_Secant):
 
     def effect_at(self, h: Any) -> dict[str, Any]:
         f, z, r = h
-        return {"effect": "resonance", "frequency": float(f), "damping_ratio": float(z),
+        return {"effect": RESONANCE, "frequency": float(f), "damping_ratio": float(z),
                 "load_fraction": float(r)}
 
     def interval_params(self, hs: list[Any], ok: np.ndarray) -> dict[str, list[float]]:

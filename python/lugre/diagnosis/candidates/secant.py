@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from ...model import Model
-from ...vocabulary import is_timing
+from ...vocabulary import DEADBAND, STRIBECK_SHAPE, is_timing
 from .. import residual as R
 from ..residual import Signals
 from .base import Candidate, Context, by, grid_interval
@@ -79,7 +79,7 @@ class _Secant(Candidate):
 
 
 class StribeckShape(_Secant):
-    effect = "stribeck_shape"
+    effect = STRIBECK_SHAPE
     param = "exponent"
     signature = ("a Stribeck curve of another shape: the friction falls from its static to "
                  "its Coulomb level more gradually (exponent under 2) or more abruptly")
@@ -88,7 +88,7 @@ class StribeckShape(_Secant):
         return np.array([0.5, 0.65, 0.8, 1.0, 1.25, 1.55, 2.6, 3.3, 4.2])
 
     def effect_at(self, h: Any) -> dict[str, Any]:
-        return {"effect": "stribeck_shape", "exponent": float(h)}
+        return {"effect": STRIBECK_SHAPE, "exponent": float(h)}
 
     def from_secant(self, h: Any, b: float) -> Any:
         return float(np.clip(2.0 + b * (float(h) - 2.0), 0.2, 10.0))
@@ -118,7 +118,7 @@ class StribeckShape(_Secant):
 
 
 class Deadband(_Secant):
-    effect = "deadband"
+    effect = DEADBAND
     param = "current"
     signature = ("a dead-band of the drive: small currents give no force, so the motor "
                  "force lags the command at every change of the current's sign")
@@ -131,7 +131,7 @@ class Deadband(_Secant):
         return top * np.geomspace(0.01, 0.8, 12)
 
     def effect_at(self, h: Any) -> dict[str, Any]:
-        return {"effect": "deadband", "current": float(h)}
+        return {"effect": DEADBAND, "current": float(h)}
 
     def columns(self, h: Any, ctx: Context) -> np.ndarray:
         if any(is_timing(e["effect"]) or e["effect"] == self.effect
