@@ -101,3 +101,23 @@ def test_from_simulation_adds_the_drive_s_imperfections():
     assert 0.05 < np.std(rec.i - r.i) < 0.2
     with pytest.raises(ValueError, match="quantum"):
         lugre.Recording.from_simulation(r, quantum=-1.0)
+
+
+def test_diagnose_draws_figures_only_when_asked(tmp_path):
+    """Without --plots no figure is drawn (they took longer than the diagnosis); with it
+    the figures land in the directory given."""
+    rec = _record(tmp_path)
+    base = [sys.executable, "-m", "lugre", "diagnose", str(rec), "--model",
+            str(tmp_path / "m.json")]
+    r = subprocess.run(base + ["--json", str(tmp_path / "a.json")], capture_output=True,
+                       text=True, check=False)
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.json", "m.json", "rec.csv"]
+    assert "plots written" not in r.stdout
+    r = subprocess.run(base + ["--json", str(tmp_path / "b.json"), "--plots",
+                               str(tmp_path / "figs")], capture_output=True, text=True,
+                       check=False)
+    assert r.returncode == 0, r.stderr
+    assert {p.name for p in (tmp_path / "figs").iterdir()} == {
+        "residual_time.png", "residual_position.png", "residual_velocity.png",
+        "residual_spectrum.png", "overlay.png"}

@@ -295,11 +295,11 @@ def _cmd_diagnose(args: argparse.Namespace) -> int:
     from .diagnosis.plots import PLOT_FILES
     from .model import load_model, save_model
 
-    plots = args.plots or str(Path(args.json).with_suffix("")) + "_plots"
+    plots = args.plots  # (figures only when asked: drawing them takes longer than the rest)
     inputs = {"RECORDING": args.recording, "--model": args.model, "--holdout": args.holdout}
     outputs = {"--json": args.json, "--out-model": args.out_model, "--html": args.html}
-    _check_outputs(inputs, outputs, {"--plots": plots})
-    for name in PLOT_FILES:  # the figures' own files: never an input or another output
+    _check_outputs(inputs, outputs, {"--plots": plots} if plots else {})
+    for name in PLOT_FILES if plots else ():  # the figures' files: no input or other output
         for opt, path in {**inputs, **outputs}.items():
             if path and _same(os.path.join(plots, name), path):
                 raise UsageError.option("--plots", f"{plots} would overwrite {path} ({opt}) "
@@ -329,9 +329,10 @@ def _cmd_diagnose(args: argparse.Namespace) -> int:
     if page is not None:
         _write_text(args.html, page)
         print(f"page written to {args.html}")
-    with pr.step("drawing the figures"):
-        files = write_plots(d, plots)
-    print(f"{len(files)} plots written to {plots}/")
+    if plots:
+        with pr.step("drawing the figures"):
+            files = write_plots(d, plots)
+        print(f"{len(files)} plots written to {plots}/")
     return 0
 
 
@@ -578,7 +579,8 @@ def build_parser() -> argparse.ArgumentParser:
                     help="the model with the findings added to its effects")
     dg.add_argument("--html", metavar="REPORT.html",
                     help="a self-contained page: verdict, findings with figures")
-    dg.add_argument("--plots", metavar="DIR", help="PNG directory (default: REPORT_plots/)")
+    dg.add_argument("--plots", metavar="DIR",
+                    help="also draw the PNG figures into DIR (none without it)")
     dg.add_argument("--screw-lead", type=_POSITIVE, metavar="M",
                     help="ball-screw lead [m] (one revolution): its pitch and harmonics are "
                          "always tried for a position-periodic force (default: the model's "
