@@ -910,3 +910,20 @@ def test_a_one_of_a_kind_effect_refined_by_little_is_kept():
     far = diagnose(rec, _with_effects(believed, [{"effect": "delay", "seconds": 0.00075}]),
                    closed_loop=False)
     assert [r["effect"] for r in far.removed] == ["delay"]
+
+
+def test_a_force_record_reads_its_dead_band_as_a_force():
+    """A record that logged the motor force F (no current, K_F = 1): what it could hide
+    of a dead-band is said in newtons, not as a current it never saw."""
+    from lugre.diagnosis.synth import case
+
+    rec, _hold, bel, _truth = case([], seed=7, duration=10.0)
+    as_force = lugre.Recording(t=rec.t, x=rec.x, F=rec.i * bel.force_constant)
+    model = bel.replace(axis={**bel.axis, "force_constant": 1.0})
+    dg = diagnose(as_force, model, closed_loop=False)
+    (db,) = [h for h in dg.could_not_reveal if h["effect"] == "deadband"]
+    assert db["unit"] == "N" and " N of motor force" in db["text"] and "A" not in db["text"]
+    dg_i = diagnose(rec, bel, closed_loop=False)
+    (db_i,) = [h for h in dg_i.could_not_reveal if h["effect"] == "deadband"]
+    assert db_i["unit"] == "A" and db_i["smallest"] * bel.force_constant == pytest.approx(
+        db["smallest"], rel=0.05)

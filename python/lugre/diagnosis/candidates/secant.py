@@ -147,7 +147,11 @@ class Deadband(_Secant):
 
     def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
         d = self.from_secant(h, float(beta[0]))
-        return (f"Currents under {d * 1e3:.3g} mA give no force ({d * ctx.model.force_constant:.3g}"
+        force = d * ctx.model.force_constant
+        if _force_recorded(ctx):  # (no current was logged: the band reads as a force)
+            return (f"Motor forces under {force:.3g} N give no force at the axis (lost at "
+                    "each sign change of the drive's force).")
+        return (f"Currents under {d * 1e3:.3g} mA give no force ({force:.3g}"
                 " N of motor force lost at each sign change of the current).")
 
     def figure(self, residual: np.ndarray, contrib: np.ndarray, ctx: Context
@@ -175,6 +179,10 @@ class Deadband(_Secant):
         d0 = 0.02
         b = d0 * float(sizes([self.columns(d0, ctx)[:, 0]])[0])
         kf = ctx.model.force_constant
+        if _force_recorded(ctx):  # (no current was logged: the band reads as a force)
+            return hide(self.effect, b * kf, "N", (f"a dead-band under {b * kf:.2g} N of motor "
+                                                   "force" if np.isfinite(b)
+                                                   else "a dead-band of any size"))
         return hide(self.effect, b, "A", (f"a dead-band under {amps(b)} ({b * kf:.2g} N of "
                                           "motor force)" if np.isfinite(b)
                                           else "a dead-band of any size"))
@@ -211,3 +219,9 @@ def deadband_braking(scorer: Any, terms: list[Any], k: int, ev: Any,
     return {"coefficient": full, "braking": b, "braking_se": se,
             "not_deadband": bool(se < 0.25 * full and abs(b - full) > 4.0 * se
                                  and abs(b - full) > 0.5 * full)}
+
+
+def _force_recorded(ctx: Context) -> bool:
+    """Whether the record logged the motor force itself (``F``), not the current."""
+    rec = getattr(ctx.sig, "recording", None)
+    return rec is not None and rec.i is None
