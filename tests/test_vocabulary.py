@@ -33,8 +33,8 @@ def test_one_of_a_kind_and_timing():
 def test_every_parameter_has_a_unit_and_every_effect_an_experiment():
     for spec in EFFECTS.values():
         assert spec.experiment and spec.abscissa in ("x", "v", "t")
-        for p in spec.parameters:
-            assert isinstance(p.unit, str)
+        for p in spec.parameters + spec.derived:
+            assert p.unit in _SI, (spec.name, p.name, p.unit)
         if spec.additive is not None:
             assert spec.additive in spec.units
 
@@ -46,6 +46,10 @@ def test_the_parser_accepts_every_name_and_rejects_others():
         lugre.Model.from_dict({**base, "effects": [eff]})
     with pytest.raises(lugre.ModelError, match="unknown effect"):
         lugre.Model.from_dict({**base, "effects": [{"effect": "backlash"}]})
+
+
+#: The SI units a linear axis's effect parameters may have.
+_SI = {"", "N", "m", "rad", "N/m", "s", "kg", "Hz", "A", "N s^2/m^2"}
 
 
 def _value(effect: str, name: str) -> object:

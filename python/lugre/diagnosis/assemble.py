@@ -83,13 +83,14 @@ def _fit(prep: Prepared, w: Weighing, sel: Selection, ev: Evidence, opts: Option
 
 
 def _unexplained(prep: Prepared, w: Weighing, sel: Selection, ev: Evidence,
-                 located: dict[str, Any], fit: dict[str, Any]) -> dict[str, Any] | None:
+                 located: dict[str, Any], fit: dict[str, Any], expected: dict[str, float]
+                 ) -> dict[str, Any] | None:
     """The rest, measured against the floor after the findings when they lowered it (a
     mismatch spread over the band, such as a lag's, raised the base refit's floor); a
     floor far above what the current's noise and the encoder explain holds mismatch
-    spread over the band: "nothing found" would hide it."""
+    spread over the band: "nothing found" would hide it. ``expected``: the floor the
+    current's noise and the encoder explain (:func:`lugre.diagnosis.residual.expected_floor`)."""
     sig, noise_after = prep.sig, ev.noise_after
-    expected = R.expected_floor(sig, ev.joint.aug)
     excess = None
     if noise_after["rms"] > EXCESS_FLOOR * expected["rms"] > 0:
         excess = {"floor": noise_after["rms"], "expected": expected["rms"]}
@@ -148,7 +149,7 @@ def assemble(prep: Prepared, q: Questioned, w: Weighing, sel: Selection, ev: Evi
                           "expected_current": expected["current"],
                           "expected_encoder": expected["encoder"]},
                    located=located,
-                   unexplained=_unexplained(prep, w, sel, ev, located, fit),
+                   unexplained=_unexplained(prep, w, sel, ev, located, fit, expected),
                    notes=_notes(q, w, sel, ev, base_rep), trials=sel.log, data=_data(prep, ev))
     dg.could_not_reveal = _hidden(w, sel, ev, opts)
     dg.removed = list(q.removed)

@@ -45,15 +45,15 @@ class Evidence:
 
 
 def _partial(prep: Prepared, w: Weighing, sel: Selection, j: Joint, r1: np.ndarray,
-             opts: Options) -> tuple[list[dict[str, Any]], Joint, np.ndarray]:
+             tot0: float, opts: Options) -> tuple[list[dict[str, Any]], Joint, np.ndarray]:
     """Most of the mismatch left over: the accepted terms are partial look-alikes of
     physics outside the vocabulary, reported as what the rest resembles, not named. The
     share is of what the base refit alone leaves: re-estimated friction levels can absorb
     most of a mismatch they do not explain (a viscous coefficient that falls as the axis
-    warms up), and the terms must explain most of the rest."""
+    warms up), and the terms must explain most of the rest. ``tot0``: the squared
+    residual of the model diagnosed."""
     sig = prep.sig
     noise_after = R.noise_floor(r1, sig)
-    tot0 = float(np.sum(w.r0[sig.mask] ** 2))
     r_base = sel.base.scorer.evaluate([]).resid
     share = 1.0 - float(np.sum(r1[sig.mask] ** 2)) / max(
         min(float(np.sum(r_base[sig.mask] ** 2)), tot0), 1e-300)
@@ -102,7 +102,7 @@ def _uncertainty(t: Term, beta: np.ndarray, effs: list[dict[str, Any]], sel: Sel
 
 
 def _finding(k: int, prep: Prepared, w: Weighing, sel: Selection, j: Joint,
-             r1: np.ndarray, opts: Options, accepted: list[dict[str, Any]],
+             r1: np.ndarray, tot0: float, opts: Options, accepted: list[dict[str, Any]],
              alternatives: dict[int, list[dict[str, Any]]]
              ) -> tuple[list[Finding], dict[str, Any]]:
     """The findings of term ``k`` (a spring whose x0 cannot be placed gives an offset
@@ -110,7 +110,6 @@ def _finding(k: int, prep: Prepared, w: Weighing, sel: Selection, j: Joint,
     sig, t, beta, ctx = prep.sig, j.terms[k], j.betas[k], j.ctx
     contrib = t.cand.columns(t.h, ctx) @ beta
     rem = r1 + contrib  # the final model without this term
-    tot0 = float(np.sum(w.r0[sig.mask] ** 2))
     gain_e = np.sum(rem[sig.mask] ** 2) - np.sum(r1[sig.mask] ** 2)
     expl = float(np.clip(gain_e / tot0, 0.0, 1.0))
     effs = t.cand.to_effects(t.h, beta, ctx)
@@ -149,7 +148,8 @@ def gather(prep: Prepared, w: Weighing, sel: Selection, j: Joint, opts: Options)
     """The evidence stage (see the module's text)."""
     sig = prep.sig
     r1 = R.residual(j.aug, sig)
-    resembles, j, r1 = _partial(prep, w, sel, j, r1, opts)
+    tot0 = float(np.sum(w.r0[sig.mask] ** 2))
+    resembles, j, r1 = _partial(prep, w, sel, j, r1, tot0, opts)
     findings: list[Finding] = []
     figures: list[dict[str, Any]] = []
     minor: list[dict[str, Any]] = []
@@ -159,12 +159,11 @@ def gather(prep: Prepared, w: Weighing, sel: Selection, j: Joint, opts: Options)
         if t.minor:  # too small to name: kept in the model, listed apart
             minor += _minor(t, j.betas[k], j, sig.mask)
             continue
-        fk, fig = _finding(k, prep, w, sel, j, r1, opts, accepted, alternatives)
+        fk, fig = _finding(k, prep, w, sel, j, r1, tot0, opts, accepted, alternatives)
         findings += fk
         figures.append(fig)
     # shares that add up: each finding's share scaled so that together they make what
     # the refit explains (dropping one term alone, the base does not re-adjust)
-    tot0 = float(np.sum(w.r0[sig.mask] ** 2))
     total = max(0.0, 1.0 - float(np.sum(r1[sig.mask] ** 2)) / tot0)
     summed = sum(f.explained for f in findings)
     if summed > total > 0.0 or (summed > 0.0 and total == 0.0):

@@ -85,17 +85,21 @@ class _Refitter:
         """Drop the terms ``why`` names (the log says why) and refit the rest, the timing
         term's form chosen again."""
         for k, reason in why.items():
-            lg = next((g for g in self.log
-                       if g["accepted"] and g["effect"] == j.terms[k].effect), None)
-            if lg is not None:
-                lg["accepted"] = False
-                lg["why"] += "; dropped: " + reason
+            _dropped(self.log, j.terms[k].effect, reason)
         keep = [k for k in range(len(j.terms)) if k not in why]
         alts = {keep.index(k): v for k, v in j.alternatives.items() if k in keep}
         return self.fit([j.terms[k] for k in keep], j.base, [j.betas[k] for k in keep], alts)
 
     def block_sse(self, m: Model) -> np.ndarray:
         return self.w.block_sse(m, self.sig)
+
+
+def _dropped(log: list[dict[str, Any]], effect: str, reason: str) -> None:
+    """The log's accepted entry of ``effect`` marked as dropped, and why."""
+    lg = next((g for g in log if g["accepted"] and g["effect"] == effect), None)
+    if lg is not None:
+        lg["accepted"] = False
+        lg["why"] += "; dropped: " + reason
 
 
 def _first_fit(rf: _Refitter, sel: Selection, w: Weighing) -> tuple[Joint, dict[str, float]]:
@@ -118,12 +122,8 @@ def _first_fit(rf: _Refitter, sel: Selection, w: Weighing) -> tuple[Joint, dict[
              < max(floor, w.min_force)]
     if small:
         for k in small:
-            lg = next((g for g in rf.log if g["accepted"] and g["effect"] == j.terms[k].effect),
-                      None)
-            if lg is not None:
-                lg["accepted"] = False
-                lg["why"] += ("; dropped: its contribution after the joint refit is "
-                              "small against the noise floor")
+            _dropped(rf.log, j.terms[k].effect,
+                     "its contribution after the joint refit is small against the noise floor")
         keep = [k for k in range(len(j.terms)) if k not in small]
         aug, base, bb, ctx, tt = rf.refine([j.terms[k] for k in keep], base0,
                                            [j.betas[k] for k in keep], 3 if keep else 2)
