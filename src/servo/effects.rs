@@ -22,6 +22,8 @@ const OFFSET: &str = "offset";
 const POSITION_FRICTION: &str = "position_friction";
 const DRIFT: &str = "drift";
 const MASS: &str = "mass";
+/// The name a rotary axis may give its `mass` effect (read as `mass`).
+const INERTIA: &str = "inertia";
 const DELAY: &str = "delay";
 const CURRENT_LAG: &str = "current_lag";
 const RESONANCE: &str = "resonance";
@@ -147,7 +149,7 @@ pub(super) fn parse_effect(e: &Value, path: &str) -> Result<Effect> {
                 time_constant: positive(n("time_constant")?, &p("time_constant"))?,
             }
         }
-        MASS => Effect::Mass { delta: n("delta")? },
+        MASS | INERTIA => Effect::Mass { delta: n("delta")? },
         DELAY => Effect::Delay {
             seconds: nonneg(n("seconds")?, &p("seconds"))?,
         },

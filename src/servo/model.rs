@@ -29,12 +29,28 @@ pub enum CurrentLoop {
     },
 }
 
+/// Whether the axis moves along a line or turns (CONTRACT, "Rotary axes").
+///
+/// The equations are the same; only the units differ: a linear axis speaks m, N, kg and
+/// N/A, a rotary one rad, N m, kg m^2 and N m/A. The core keeps one set of fields
+/// (`mass` holds a rotary axis's inertia, `force_constant` its torque constant).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AxisKind {
+    /// A linear axis (`"kind": "linear"`, the default): `mass`, `force_constant`.
+    #[default]
+    Linear,
+    /// A rotary axis (`"kind": "rotary"`): `inertia`, `torque_constant`.
+    Rotary,
+}
+
 /// The axis.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Axis {
-    /// Moving mass [kg].
+    /// Linear or rotary.
+    pub kind: AxisKind,
+    /// Moving mass [kg], or a rotary axis's inertia [kg m^2].
     pub mass: f64,
-    /// Force constant K_F [N/A].
+    /// Force constant K_F [N/A], or a rotary axis's torque constant [N m/A].
     pub force_constant: f64,
     /// Optional current loop.
     pub current_loop: Option<CurrentLoop>,
@@ -309,6 +325,7 @@ impl Model {
         };
         Model {
             axis: Axis {
+                kind: AxisKind::Linear,
                 mass: 25.0,
                 force_constant: 25.0,
                 current_loop: None,
@@ -382,9 +399,15 @@ impl Model {
                 }
             }
         };
+        let kind = parse_axis_kind(a)?;
+        let (mass_key, constant_key) = match kind {
+            AxisKind::Linear => ("mass", "force_constant"),
+            AxisKind::Rotary => ("inertia", "torque_constant"),
+        };
         let axis = Axis {
-            mass: positive(num(a, "mass", "axis")?, "axis.mass")?,
-            force_constant: positive(num(a, "force_constant", "axis")?, "axis.force_constant")?,
+            kind,
+            mass: positive(num(a, mass_key, "axis")?, &join("axis", mass_key))?,
+            force_constant: positive(num(a, constant_key, "axis")?, &join("axis", constant_key))?,
             current_loop: cl,
             current_limit: match opt_num(a, "current_limit", "axis")? {
                 None => None,
@@ -459,6 +482,11 @@ impl Model {
             effects,
             controller,
         })
+    }
+
+    /// Whether the axis is rotary (positions in rad, forces in N m).
+    pub fn is_rotary(&self) -> bool {
+        self.axis.kind == AxisKind::Rotary
     }
 
     /// Exponent of the plant's Stribeck curve when a `stribeck_shape` effect sets one.
@@ -543,6 +571,19 @@ fn parse_controller(c: &Value, friction: &LugreParams<f64>) -> Result<Controller
     })
 }
 
+/// The axis's `kind`: `"linear"` (the default) or `"rotary"`.
+fn parse_axis_kind(a: &Value) -> Result<AxisKind> {
+    match a.get("kind") {
+        None | Some(Value::Null) => Ok(AxisKind::Linear),
+        Some(Value::String(k)) if k == "linear" => Ok(AxisKind::Linear),
+        Some(Value::String(k)) if k == "rotary" => Ok(AxisKind::Rotary),
+        Some(_) => Err(Error::model(
+            "axis.kind",
+            "must be \"linear\" (mass, force_constant) or \"rotary\" (inertia, torque_constant)",
+        )),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -583,6 +624,28 @@ mod tests {
             m.controller.unwrap().law,
             ControlLaw::Pid { kd, .. } if kd == 1500.0
         ));
+    }
+
+    #[test]
+    fn a_rotary_axis_reads_inertia_and_torque_constant() {
+        let rotary = PAPER.replace(
+            r#""axis": {"mass": 25.0, "force_constant": 25.0}"#,
+            r#""axis": {"kind": "rotary", "inertia": 0.5, "torque_constant": 2.0}"#,
+        );
+        let m = Model::from_json(&rotary).unwrap();
+        assert!(m.is_rotary() && !Model::paper().is_rotary());
+        assert_eq!((m.axis.mass, m.axis.force_constant), (0.5, 2.0));
+        let inertia = rotary.replace(
+            r#""effects": []"#,
+            r#""effects": [{"effect": "inertia", "delta": 0.25}]"#,
+        );
+        assert_eq!(Model::from_json(&inertia).unwrap().total_mass(), 0.75);
+        let missing = rotary.replace(r#""inertia": 0.5, "#, "");
+        let e = Model::from_json(&missing).unwrap_err().to_string();
+        assert!(e.contains("axis.inertia"), "{e}");
+        let odd = PAPER.replace(r#""mass": 25.0"#, r#""kind": "spherical", "mass": 25.0"#);
+        let e = Model::from_json(&odd).unwrap_err().to_string();
+        assert!(e.contains("axis.kind") && e.contains("rotary"), "{e}");
     }
 
     #[test]

@@ -82,6 +82,7 @@ class _CurrentLoop:
 
 @dataclass(frozen=True)
 class _Axis:
+    kind: str
     mass: float
     force_constant: float
     current_loop: _CurrentLoop | None
@@ -399,18 +400,36 @@ def _parse_controller(c: Any, friction: _Friction) -> _Controller:
     return _Controller(kind, kp, ki, kd, rate, ff_kind, ff_friction)
 
 
+#: The keys of the axis's mass and force constant, by ``axis.kind``.
+_AXIS_KEYS = {"linear": ("mass", "force_constant"), "rotary": ("inertia", "torque_constant")}
+
+
+def _axis_kind(a: Mapping[str, Any]) -> str:
+    """The axis's ``kind``, ``"linear"`` when absent (as ``parse_axis_kind``)."""
+    k = a.get("kind")
+    if k is None:
+        return "linear"
+    if not isinstance(k, str) or k not in _AXIS_KEYS:
+        raise ModelError(
+            "axis.kind",
+            'must be "linear" (mass, force_constant) or "rotary" (inertia, torque_constant)')
+    return k
+
+
 def _parse(v: Mapping[str, Any]) -> _Parsed:
     """Validate a model document exactly as ``Model::from_value`` does."""
     v = _obj(v, "")
     a = _obj(_get(v, "axis", ""), "axis")
     cl = a.get("current_loop")
     current_loop = None if cl is None else _parse_current_loop(cl)
-    mass = _positive(_num(a, "mass", "axis"), "axis.mass")
-    kf = _positive(_num(a, "force_constant", "axis"), "axis.force_constant")
+    kind = _axis_kind(a)
+    mass_key, constant_key = _AXIS_KEYS[kind]
+    mass = _positive(_num(a, mass_key, "axis"), "axis." + mass_key)
+    kf = _positive(_num(a, constant_key, "axis"), "axis." + constant_key)
     lim = _opt_num(a, "current_limit", "axis")
     if lim is not None:
         lim = _positive(lim, "axis.current_limit")
-    axis = _Axis(mass, kf, current_loop, lim)
+    axis = _Axis(kind, mass, kf, current_loop, lim)
     friction = _parse_friction(_get(v, "friction", ""), "friction")
     effects = _parse_effects(v, mass)
     c = v.get("controller")
