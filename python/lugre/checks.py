@@ -16,6 +16,9 @@ __all__ = ["MAX_SPAN", "MAX_SPEED", "require_plausible", "resample_uniform"]
 MAX_SPAN = 5.0
 #: Largest speed [m/s] of a plausible servo-axis recording.
 MAX_SPEED = 20.0
+#: Largest speed [rad/s] of a plausible rotary-axis recording (a motor shaft at
+#: 10 000 rpm); faster, the positions are likely degrees.
+MAX_ROTARY_SPEED = 1100.0
 #: A sample interval longer than this many median intervals is a gap.
 GAP_FACTOR = 1.5
 
@@ -24,8 +27,10 @@ def _name(rec: Recording) -> str:
     return rec.source or "the recording"
 
 
-def require_plausible(rec: Recording) -> Recording:
-    """Return ``rec`` when its sampling is uniform and its units look like metres.
+def require_plausible(rec: Recording, axis_kind: str | None = None) -> Recording:
+    """Return ``rec`` when its sampling is uniform and its units look like metres (on a
+    rotary axis, ``axis_kind="rotary"`` or the recording's ``meta["axis_kind"]``:
+    radians).
 
     Raises
     ------
@@ -61,9 +66,11 @@ def require_plausible(rec: Recording) -> Recording:
             "sampling: add --resample (Python: lugre.io.resample_uniform(rec)) to "
             "interpolate onto a uniform grid, or cut the record at the gaps"
         )
-    span = float(np.ptp(rec.x))
     speed = np.abs(np.diff(rec.x)) / med
     vmax = float(np.percentile(speed, 99)) if speed.size else 0.0
+    if (axis_kind or rec.meta.get("axis_kind")) == "rotary":
+        return _plausible_rotary(rec, vmax)
+    span = float(np.ptp(rec.x))
     if span > MAX_SPAN or vmax > MAX_SPEED:
         what = (f"the positions span {span:.4g} m" if span > MAX_SPAN
                 else f"the speed reaches {vmax:.4g} m/s")
@@ -72,6 +79,17 @@ def require_plausible(rec: Recording) -> Recording:
             "millimetres, but recordings are in metres: add --x-unit mm (Python: "
             "read_recording(..., x_unit='mm')) or map the column as x=pos/1000"
         )
+    return rec
+
+
+def _plausible_rotary(rec: Recording, vmax: float) -> Recording:
+    """A rotary axis's record: any number of turns, at most :data:`MAX_ROTARY_SPEED`."""
+    if vmax > MAX_ROTARY_SPEED:
+        raise DataError(
+            f"{_name(rec)}: the speed reaches {vmax:.4g} rad/s ({vmax * 30 / np.pi:.4g} "
+            "rpm), beyond a servo axis: the positions look like degrees, but a rotary "
+            "axis's recordings are in radians: add --x-unit deg (Python: "
+            "read_recording(..., x_unit='deg'))")
     return rec
 
 

@@ -158,16 +158,33 @@ def _note(msg: str) -> None:
     print(f"note: {msg}", file=sys.stderr)
 
 
-def _read(args: argparse.Namespace, path: str, option: str = "RECORDING") -> Any:
+def _x_unit(args: argparse.Namespace, kind: str | None) -> str:
+    """The recording's position unit: ``--x-unit``, else the model's axis's (m or rad);
+    a unit of the other kind of axis than the model's is refused."""
+    from .readers import ROTARY_X_UNITS
+
+    unit = getattr(args, "x_unit", None)
+    if unit is None:
+        return "rad" if kind == "rotary" else "m"
+    if kind is not None and (unit in ROTARY_X_UNITS) != (kind == "rotary"):
+        want = "rad or deg" if kind == "rotary" else "m, mm, um or cm"
+        raise UsageError.option("--x-unit", f"{unit} is not a position of the model's "
+                                f"{kind} axis: use {want}")
+    return str(unit)
+
+
+def _read(args: argparse.Namespace, path: str, option: str = "RECORDING",
+          kind: str | None = None) -> Any:
     """Read a recording with the command's column mapping, unit and resampling options,
-    and refuse it when its sampling has gaps or its units look wrong."""
+    and refuse it when its sampling has gaps or its units look wrong (``kind``: the
+    model's axis, ``"linear"`` or ``"rotary"``, when a model is given)."""
     from .checks import require_plausible, resample_uniform
     from .io import read_recording
 
+    x_unit = _x_unit(args, kind)
     try:
         with _progress(args).step(f"reading {path}"):
-            rec = read_recording(path, _columns(args.columns),
-                                 x_unit=getattr(args, "x_unit", "m"))
+            rec = read_recording(path, _columns(args.columns), x_unit=x_unit)
     except InputError as e:
         if e.name in ("columns", "x_unit"):
             text = str(e).split(": ", 1)[-1]
@@ -178,7 +195,7 @@ def _read(args: argparse.Namespace, path: str, option: str = "RECORDING") -> Any
         rec = resample_uniform(rec)
         print(f"{path}: resampled: {n} samples linearly interpolated onto a uniform grid of "
               f"{len(rec)} samples, dt = {rec.dt:.6g} s")
-    return require_plausible(rec)
+    return require_plausible(rec, kind)
 
 
 # --------------------------------------------------------------------------------------
@@ -206,7 +223,8 @@ def _cmd_fit_static(args: argparse.Namespace) -> int:
     else:
         kf = args.force_constant or (base.force_constant if base else None)
         with pr.step(f"finding the plateaus of {args.data}"):
-            pts = steady_state_points(_read(args, args.data), kf, chunks=args.chunks)
+            pts = steady_state_points(_read(args, args.data, kind=base and base.kind), kf,
+                                      chunks=args.chunks)
         used = sum(p["settled"] for p in pts.plateaus)
         print(f"{args.data}: {len(pts.plateaus)} plateaus found, {used} settled and used "
               f"({int(pts.used.sum())} samples) -> {len(pts.v)} points")
@@ -271,7 +289,7 @@ def _cmd_fit_dynamic(args: argparse.Namespace) -> int:
 
     _check_outputs({"RECORDING": args.recording, "--model": args.model}, {"--json": args.json})
     model = load_model(args.model)
-    rec = _read(args, args.recording)
+    rec = _read(args, args.recording, kind=model.kind)
     with _progress(args).step("fitting sigma0 and sigma1 (closed-loop simulations)"):
         fit = fit_dynamic(rec, model, weighting=args.weighting, c1=args.c1, c2=args.c2,
                           scale_floor=args.resolution)
@@ -306,8 +324,8 @@ def _cmd_diagnose(args: argparse.Namespace) -> int:
                                         f"with its figure {name}: choose another directory")
     pr = _progress(args)
     model = load_model(args.model)
-    rec = _read(args, args.recording)
-    hold = _read(args, args.holdout, "--holdout") if args.holdout else None
+    rec = _read(args, args.recording, kind=model.kind)
+    hold = _read(args, args.holdout, "--holdout", model.kind) if args.holdout else None
     with pr.step("diagnosing (candidate effects, joint refits, held-out checks)"):
         d = diagnose(rec, model, holdout=hold, screw_lead=args.screw_lead,
                      cutoff_hz=args.cutoff_hz)
@@ -343,7 +361,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 
     _check_outputs({"RECORDING": args.recording, "--model": args.model}, {"--json": args.json})
     model = load_model(args.model)
-    ev = evaluate(_read(args, args.recording), model)
+    ev = evaluate(_read(args, args.recording, kind=model.kind), model)
     print(f"rms force residual {ev['rms_force']:.4g} N, nrmse {100 * ev['nrmse_force']:.3g} %")
     shift = level_shift_text(ev.get("level_shift"))
     if shift:
@@ -354,16 +372,26 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 
 
 def _cmd_fit(args: argparse.Namespace) -> int:
-    from .diagnosis import evaluate, fit_inverse_dynamics, fit_model
-    from .diagnosis.fitreport import identification
-    from .model import save_model
+    from . import units as U
 
     effects = [e.strip() for e in (args.effects or "").split(",") if e.strip()]
     _check_outputs({"RECORDING": args.recording}, {"--json": args.json, "--html": args.html})
     rec = _read(args, args.recording)
+    with U.axis(rec.meta.get("axis_kind", "linear")):
+        return _fit_and_write(args, rec, effects)
+
+
+def _fit_and_write(args: argparse.Namespace, rec: Any, effects: list[str]) -> int:
+    """``lugre fit`` once the recording is read, in the units of its axis."""
+    from . import units as U
+    from .diagnosis import evaluate, fit_inverse_dynamics, fit_model
+    from .diagnosis.fitreport import identification
+    from .model import save_model
+
     if rec.F is None and args.force_constant is None:
         raise UsageError.option("--force-constant", f"{args.recording} holds the current i: "
-                                "give the force constant K_F [N/A] with --force-constant")
+                                f"give the {_constant_words()} [{U.si('N/A')}] with "
+                                "--force-constant")
     kf = args.force_constant or 1.0
     pr = _progress(args)
     fit = None
@@ -375,18 +403,12 @@ def _cmd_fit(args: argparse.Namespace) -> int:
                      + (f" with {', '.join(effects)}" if effects else "")):
             model, fit = fit_model(rec, effects=effects, mass=args.mass, force_constant=kf)
     nrmse = evaluate(rec, model)["nrmse_force"]
-    print(f"force residual {100 * nrmse:.2f} % of the motor force (rms)"
-          + (" after the inverse-dynamics least squares alone" if fit is None else ""))
+    print(f"{U.force_words()} residual {100 * nrmse:.2f} % of the motor {U.force_words()} "
+          "(rms)" + (" after the inverse-dynamics least squares alone" if fit is None else ""))
     if fit is not None:
         _print_fit(fit, effects)
         model = model.replace(identification=identification(fit, model, nrmse))
-    for d in ("positive", "negative"):
-        p = getattr(model, d)
-        print(f"{d:8s} fc {p['fc']:.4g} N  fs {p['fs']:.4g} N  sigma2 {p['sigma2']:.4g} N s/m  "
-              f"vs {p['vs']:.4g} m/s")
-    kf_txt = (f", force constant {model.force_constant:.4g} N/A" if rec.F is None else "")
-    print(f"mass {model.mass:.4g} kg, sigma0 {model.sigma0:.4g} N/m, sigma1 {model.sigma1:.4g} "
-          f"N s/m{kf_txt}")
+    _print_model(model, rec.F is None)
     page = None
     if args.html:
         from .html import fit_page
@@ -400,6 +422,26 @@ def _cmd_fit(args: argparse.Namespace) -> int:
         _write_text(args.html, page)
         print(f"page written to {args.html}")
     return 0
+
+
+def _constant_words() -> str:
+    from . import units as U
+
+    return "torque constant K_T" if U.is_rotary() else "force constant K_F"
+
+
+def _print_model(model: Any, with_constant: bool) -> None:
+    """The fitted base, each number in the axis's unit."""
+    from . import units as U
+
+    for d in ("positive", "negative"):
+        p = getattr(model, d)
+        print(f"{d:8s} fc {p['fc']:.4g} {U.si('N')}  fs {p['fs']:.4g} {U.si('N')}  "
+              f"sigma2 {p['sigma2']:.4g} {U.si('N s/m')}  vs {p['vs']:.4g} {U.si('m/s')}")
+    kf_txt = (f", {_constant_words().rsplit(' ', 1)[0]} {model.force_constant:.4g} "
+              f"{U.si('N/A')}" if with_constant else "")
+    print(f"{U.mass_words()} {model.mass:.4g} {U.si('kg')}, sigma0 {model.sigma0:.4g} "
+          f"{U.si('N/m')}, sigma1 {model.sigma1:.4g} {U.si('N s/m')}{kf_txt}")
 
 
 def _print_fit(fit: Any, effects: list[str]) -> None:
@@ -472,7 +514,8 @@ _EXAMPLES = {
                 "      --json report.json --html report.html --out-model augmented.json",
     "evaluate": "lugre evaluate recording.csv --model model.json --json eval.json",
     "fit": "lugre fit recording.csv --force-constant 25 --json model.json --html fit.html\n"
-           "  lugre fit DATA_EMPS.mat --columns 'x=qm,x_ref=qg,F=gtau*vir' --json emps.json",
+           "  lugre fit DATA_EMPS.mat --columns 'x=qm,x_ref=qg,F=gtau*vir' --json emps.json\n"
+           "  lugre fit joint.csv --x-unit deg --force-constant 0.6 --json joint.json",
     "paper": "lugre paper --out paper/ --html paper.html",
     "design-static": "lugre design-static points.csv --target 0.003 --budget 96 --json design.json",
 }
@@ -513,9 +556,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     def recording_options(sp: argparse.ArgumentParser) -> None:
         sp.add_argument("--columns", **c)
-        sp.add_argument("--x-unit", choices=["m", "mm", "um", "cm"], default="m",
-                        help="unit of the recorded positions (and speeds per second); "
-                             "converted to m")
+        sp.add_argument("--x-unit", choices=["m", "mm", "um", "cm", "rad", "deg"],
+                        default=None,
+                        help="unit of the recorded positions (and speeds per second), "
+                             "converted to m; rad and deg make it a rotary axis's, in rad "
+                             "(default: the model's axis's unit, m without a model)")
         sp.add_argument("--resample", action="store_true",
                         help="interpolate linearly onto a uniform time grid when the "
                              "sampling has gaps (said in the output)")

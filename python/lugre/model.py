@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any, Union
 
 from .exceptions import InputError, ModelError, ParameterError, PassivityWarning
-from .vocabulary import EFFECTS, MASS_EFFECTS
+from .vocabulary import ALIASES, EFFECTS, MASS_EFFECTS, canonical
 
 __all__ = ["Model", "ModelLike", "load_model", "save_model"]
 
@@ -105,7 +105,7 @@ class Model:
                 "(model)",
                 f"must be a mapping (the model JSON object), found {type(data).__name__}",
             )
-        self._data = _plain(data)
+        self._data = _canonical(_plain(data))
         self._core = _validated(self._data)
         self._warn_passivity()
 
@@ -257,9 +257,20 @@ class Model:
     # ---- access -----------------------------------------------------------------------
 
     @property
+    def kind(self) -> str:
+        """``"linear"`` or ``"rotary"`` (``axis.kind``; CONTRACT, "Rotary axes")."""
+        return "rotary" if self._data["axis"].get("kind") == "rotary" else "linear"
+
+    @property
+    def is_rotary(self) -> bool:
+        """Whether the axis turns: positions in rad, forces in N m, inertia in kg m^2."""
+        return self.kind == "rotary"
+
+    @property
     def mass(self) -> float:
-        """Moving mass ``axis.mass`` [kg] (without ``mass`` effects)."""
-        return float(self._data["axis"]["mass"])
+        """Moving mass ``axis.mass`` [kg], or a rotary axis's ``axis.inertia`` [kg m^2]
+        (without ``mass`` effects)."""
+        return float(self._data["axis"][_AXIS_KEYS[self.kind][0]])
 
     @property
     def total_mass(self) -> float:
@@ -270,8 +281,19 @@ class Model:
 
     @property
     def force_constant(self) -> float:
-        """Force constant K_F ``axis.force_constant`` [N/A]."""
-        return float(self._data["axis"]["force_constant"])
+        """Force constant K_F ``axis.force_constant`` [N/A], or a rotary axis's
+        ``axis.torque_constant`` [N m/A]."""
+        return float(self._data["axis"][_AXIS_KEYS[self.kind][1]])
+
+    def with_axis(self, *, mass: float | None = None,
+                  force_constant: float | None = None) -> Model:
+        """A new model with the mass (a rotary axis's inertia) or the force constant
+        (torque constant) changed, written under the axis's own keys."""
+        axis = self.axis
+        for key, val in zip(_AXIS_KEYS[self.kind], (mass, force_constant)):
+            if val is not None:
+                axis[key] = float(val)
+        return self.replace(axis=axis)
 
     @property
     def sigma0(self) -> float:
@@ -402,10 +424,33 @@ class Model:
     def _checked(cls, plain: dict[str, Any]) -> Model:
         """A model of a JSON-ready document (validated, not copied again)."""
         m = cls.__new__(cls)
-        m._data = plain
+        m._data = _canonical(plain)
         m._core = _validated(plain)
         m._warn_passivity()
         return m
+
+
+#: The keys of the mass and the force constant of each kind of axis.
+_AXIS_KEYS = {"linear": ("mass", "force_constant"), "rotary": ("inertia", "torque_constant")}
+
+
+def axis_document(kind: str, mass: float, force_constant: float) -> dict[str, Any]:
+    """The ``axis`` object of a ``kind`` axis (``"linear"`` or ``"rotary"``)."""
+    keys = _AXIS_KEYS["rotary" if kind == "rotary" else "linear"]
+    doc: dict[str, Any] = {"kind": "rotary"} if kind == "rotary" else {}
+    return {**doc, keys[0]: float(mass), keys[1]: float(force_constant)}
+
+
+def _canonical(doc: dict[str, Any]) -> dict[str, Any]:
+    """The document with every effect under its vocabulary name (a rotary axis's
+    ``inertia`` effect is a ``mass`` effect), so that the rest reads one name."""
+    effects = doc.get("effects")
+    if isinstance(effects, list) and any(
+            isinstance(e, dict) and e.get("effect") in ALIASES for e in effects):
+        doc = {**doc, "effects": [
+            {**e, "effect": canonical(e["effect"])}
+            if isinstance(e, dict) and e.get("effect") in ALIASES else e for e in effects]}
+    return doc
 
 
 def _passivity_bound(s: Mapping[str, Any]) -> float:

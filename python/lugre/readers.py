@@ -31,7 +31,7 @@ from .columns import _SAMPLE_TIME_NAMES, ColumnSpec, _is_number, _missing, _pars
 from .exceptions import FileFormatError, InputError
 from .recording import COLUMNS, Recording
 
-__all__ = ["MAX_MAGNITUDE", "X_UNITS", "is_points_file", "read_points", "read_recording", "write_recording"]
+__all__ = ["MAX_MAGNITUDE", "ROTARY_X_UNITS", "X_UNITS", "is_points_file", "read_points", "read_recording", "write_recording"]
 
 def _read_csv_table(path: str) -> tuple[dict[str, str], list[str], list[tuple[int, list[str]]]]:
     """Metadata, header and data rows (with their 1-based line numbers) of a CSV file."""
@@ -176,8 +176,13 @@ def _read_arrays(path: str, suffix: str) -> tuple[dict[str, np.ndarray], dict[st
     return arrays, meta
 
 
-#: Position units that ``x_unit`` accepts, with their size in metres.
-X_UNITS: dict[str, float] = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "cm": 1e-2}
+#: Position units that ``x_unit`` accepts, with their size in metres (a linear axis's)
+#: or in radians (a rotary axis's: ``rad``, ``deg``).
+X_UNITS: dict[str, float] = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "cm": 1e-2,
+                             "rad": 1.0, "deg": math.pi / 180.0}
+
+#: The units of :data:`X_UNITS` that make a recording a rotary axis's.
+ROTARY_X_UNITS = ("rad", "deg")
 
 #: Largest magnitude a recorded value may have: beyond it a product (``K_F*i``, ``x**2``)
 #: overflows or swamps every other sample; it is a corrupt cell, not a measurement.
@@ -207,10 +212,11 @@ def read_recording(path: str | os.PathLike[str], columns: ColumnSpec = None, *,
         In ``.mat``/``.npz`` files, ``t`` may be mapped to (or, unmapped, found as) a
         scalar sample time (``dt``, ``Ts``, ``ts``, ``Te``, ...), giving
         ``t = dt*arange(n)``.
-    x_unit : {"m", "mm", "um", "cm"}
+    x_unit : {"m", "mm", "um", "cm", "rad", "deg"}
         The unit of the file's positions (``x``, ``x_ref``) and speeds (``v``,
-        ``v_ref``, per second); they are converted to metres and the conversion is
-        noted in ``meta["x_unit"]``.
+        ``v_ref``, per second); they are converted to metres (``rad`` and ``deg``: to
+        radians, a rotary axis's, noted as ``meta["axis_kind"] = "rotary"``) and the
+        conversion is noted in ``meta["x_unit"]``.
 
     Returns
     -------
@@ -311,11 +317,14 @@ def read_recording(path: str | os.PathLike[str], columns: ColumnSpec = None, *,
     vector_names = names if csv else [k for k in names if arrays[k].ndim == 1]
     _check_found(p, found, origin, names, vector_names, row_of if csv else None)
     scale = X_UNITS[x_unit]
+    if x_unit in ROTARY_X_UNITS:
+        meta = {**meta, "axis_kind": "rotary"}
     if scale != 1.0:
         for c in ("x", "x_ref", "v", "v_ref"):
             if c in found:
                 found[c] = found[c] * scale
-        meta = {**meta, "x_unit": f"positions and speeds read in {x_unit}, converted to m"}
+        to = "rad" if x_unit in ROTARY_X_UNITS else "m"
+        meta = {**meta, "x_unit": f"positions and speeds read in {x_unit}, converted to {to}"}
     return Recording(**found, meta=meta, source=p)
 
 

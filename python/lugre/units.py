@@ -1,17 +1,85 @@
 """Units and number formatting for pages a person reads: one unit per quantity.
 
-Positions are shown in millimetres, speeds in millimetres per second, times in seconds,
-forces in newtons; every other parameter in the unit of the CONTRACT's vocabulary.
+On a linear axis positions are shown in millimetres, speeds in millimetres per second,
+forces in newtons; on a rotary axis (CONTRACT, "Rotary axes") positions in rad, speeds
+in rad/s, forces in N m, masses in kg m^2. Times are in seconds; every other parameter
+in the unit of the CONTRACT's vocabulary.
+
+The vocabulary and the code write units as a linear axis's SI units (``"N"``,
+``"m/s"``); :func:`si` and :func:`display` turn them into the axis's own. Which axis is
+set for a stretch of work by :func:`axis` (a context variable: the diagnosis, the fit
+and the pages set it from the model they are given).
 """
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import math
+from collections.abc import Iterator
 from typing import Any
 
 from .vocabulary import EFFECTS
 
-__all__ = ["BASE_UNITS", "EFFECT_UNITS", "display", "fmt", "fmt_range"]
+__all__ = ["EFFECT_UNITS", "axis", "axis_kind", "axis_units", "base_unit", "display", "fmt", "fmt_range", "force_words",
+           "is_rotary", "mass_words", "position_unit", "si", "where_unit"]
+
+#: A linear axis's SI units and a rotary axis's for the same quantity.
+_ROTARY = {
+    "m": "rad", "m/s": "rad/s", "m/s^2": "rad/s^2", "m/s²": "rad/s²", "N": "N m",
+    "N/m": "N m/rad", "N s/m": "N m s/rad", "N s^2/m^2": "N m s^2/rad^2",
+    "N s²/m²": "N m s²/rad²", "kg": "kg m^2", "N/A": "N m/A", "N/s": "N m/s",
+}
+
+_KIND: contextvars.ContextVar[str] = contextvars.ContextVar("lugre_axis_kind",
+                                                            default="linear")
+
+
+@contextlib.contextmanager
+def axis(kind: str) -> Iterator[None]:
+    """Speak ``kind``'s units (``"linear"`` or ``"rotary"``) inside the ``with``."""
+    token = _KIND.set("rotary" if kind == "rotary" else "linear")
+    try:
+        yield
+    finally:
+        _KIND.reset(token)
+
+
+def axis_kind() -> str:
+    """The kind of axis whose units are spoken now (``"linear"`` unless set)."""
+    return _KIND.get()
+
+
+def is_rotary() -> bool:
+    """Whether the units spoken now are a rotary axis's."""
+    return _KIND.get() == "rotary"
+
+
+def axis_units(kind: str) -> dict[str, str]:
+    """What a report says of its axis: ``kind`` and the SI unit of each quantity."""
+    with axis(kind):
+        return {"kind": axis_kind(), **{q: si(u) for q, u in _QUANTITIES.items()}}
+
+
+#: The quantities a report's numbers are in, with a linear axis's SI unit.
+_QUANTITIES = {"position": "m", "velocity": "m/s", "force": "N", "mass": "kg",
+               "force_constant": "N/A"}
+
+
+def force_words() -> str:
+    """``"force"``, or ``"torque"`` on a rotary axis."""
+    return "torque" if is_rotary() else "force"
+
+
+def mass_words() -> str:
+    """``"mass"``, or ``"inertia"`` on a rotary axis."""
+    return "inertia" if is_rotary() else "mass"
+
+
+def si(unit: str) -> str:
+    """The axis's SI unit for a linear axis's SI ``unit`` (``"N"`` -> ``"N m"`` on a
+    rotary axis; others unchanged)."""
+    return _ROTARY.get(unit, unit) if is_rotary() else unit
 
 #: Display unit and factor from SI for each quantity.
 POSITION = ("mm", 1e3)
@@ -21,17 +89,30 @@ SPEED = ("mm/s", 1e3)
 EFFECT_UNITS: dict[str, dict[str, tuple[str, float]]] = {
     name: spec.display for name, spec in EFFECTS.items()}
 
-#: Units of the base model's parameters.
-BASE_UNITS: dict[str, tuple[str, float]] = {
-    "mass": ("kg", 1.0), "force_constant": ("N/A", 1.0), "sigma0": ("N/m", 1.0),
-    "sigma1": ("N s/m", 1.0), "fc": ("N", 1.0), "fs": ("N", 1.0), "sigma2": ("N s/m", 1.0),
-    "vs": SPEED,
-}
+#: SI units (of a linear axis) of the base model's parameters.
+_BASE_SI = {"mass": "kg", "force_constant": "N/A", "sigma0": "N/m", "sigma1": "N s/m",
+            "fc": "N", "fs": "N", "sigma2": "N s/m", "vs": "m/s"}
 
-#: Units of the ``where`` ranges.
-WHERE_UNITS: dict[str, tuple[str, float]] = {
-    "position": POSITION, "time": ("s", 1.0), "velocity": SPEED,
-}
+#: SI units (of a linear axis) of the ``where`` ranges.
+_WHERE_SI = {"position": "m", "time": "s", "velocity": "m/s"}
+
+
+def base_unit(name: str) -> tuple[str, float]:
+    """Display unit and factor of a base parameter (``mass``, ``fc``, ``vs``, ...) on
+    the axis spoken now; ``("", 1.0)`` when unknown."""
+    unit = _BASE_SI.get(name)
+    return ("", 1.0) if unit is None else display(unit)
+
+
+def where_unit(key: str) -> tuple[str, float]:
+    """Display unit and factor of a ``where`` range (``position``, ``time``,
+    ``velocity``) on the axis spoken now."""
+    return display(_WHERE_SI.get(key, ""))
+
+
+def position_unit() -> tuple[str, float]:
+    """Display unit and factor of a position on the axis spoken now."""
+    return display("m")
 
 #: Unit of a unit name used in reports (``m``, ``m/s``) turned into its display unit.
 _DISPLAY = {"m": POSITION, "m/s": SPEED, "s": ("s", 1.0), "N": ("N", 1.0),
@@ -40,18 +121,30 @@ _DISPLAY = {"m": POSITION, "m/s": SPEED, "s": ("s", 1.0), "N": ("N", 1.0),
 
 def unit_of(effect: str | None, name: str) -> tuple[str, float]:
     """Display unit and factor of a parameter (``("", 1.0)`` when unknown)."""
-    if effect and name in EFFECT_UNITS.get(effect, {}):
-        return EFFECT_UNITS[effect][name]
+    spec = EFFECTS.get(effect or "")
+    if spec is not None and name in spec.units:
+        return _on_axis(spec.units[name], spec.display[name])
     base = name.rsplit(".", 1)[-1]
     for suffix in ("_positive", "_negative"):
         base = base.removesuffix(suffix)
-    return BASE_UNITS.get(base, ("", 1.0))
+    return base_unit(base)
+
+
+def _on_axis(unit: str, linear_display: tuple[str, float]) -> tuple[str, float]:
+    """A parameter's display unit on the axis spoken now: a rotary axis shows the SI
+    unit of its own (rad, N m) where a linear one shows millimetres."""
+    if is_rotary() and unit in _ROTARY:
+        return (_ROTARY[unit], 1.0)
+    return linear_display
 
 
 def display(unit: str | None) -> tuple[str, float]:
-    """The display unit and factor for a value given in the SI ``unit``."""
+    """The display unit and factor for a value given in the (linear) SI ``unit``, on
+    the axis spoken now."""
     if not unit:
         return ("", 1.0)
+    if is_rotary():
+        return (_ROTARY.get(unit, unit), 1.0)
     return _DISPLAY.get(unit, (unit, 1.0))
 
 

@@ -11,10 +11,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["COGGING", "CURRENT_LAG", "DEADBAND", "DELAY", "DRAG", "DRIFT", "EFFECTS", "MASS",
-           "MASS_EFFECTS", "NAMES", "OFFSET", "ONE_OF_A_KIND", "POSITION_FRICTION", "RESONANCE",
+__all__ = ["ALIASES", "COGGING", "CURRENT_LAG", "DEADBAND", "DELAY", "DRAG", "DRIFT", "EFFECTS",
+           "MASS", "MASS_EFFECTS", "NAMES", "OFFSET", "ONE_OF_A_KIND", "POSITION_FRICTION", "RESONANCE",
            "SPRING", "STRIBECK_SHAPE", "TIMING", "TIMING_FORMS", "Effect", "Parameter",
-           "held_kinds", "is_timing", "kind"]
+           "canonical", "held_kinds", "is_timing", "kind"]
 
 
 #: The effect names, each spelled here once; everything else takes them from here.
@@ -145,6 +145,16 @@ TIMING_FORMS: tuple[str, ...] = tuple(n for n, e in EFFECTS.items() if e.kind ==
 #: Kinds a model holds once at most (the timing kind is ``delay``, for both forms).
 ONE_OF_A_KIND: tuple[str, ...] = tuple(dict.fromkeys(
     e.kind for e in EFFECTS.values() if e.one_of_a_kind))
+
+
+#: Other names the model file may give an effect: a rotary axis's ``mass`` effect is
+#: written ``inertia`` (CONTRACT, "Rotary axes").
+ALIASES: dict[str, str] = {"inertia": MASS}
+
+
+def canonical(effect: str) -> str:
+    """The vocabulary's name of an effect written under another name (``inertia``)."""
+    return ALIASES.get(effect, effect)
 
 
 def kind(effect: str) -> str:

@@ -73,12 +73,14 @@ def apply_base(model: Model, values: dict[str, float]) -> Model:
     -------
     Model
     """
+    if "mass" in values:
+        model = model.with_axis(mass=max(float(values["mass"]), 1e-6))
     d = model.to_dict()
     f = d["friction"]
     for name, val in values.items():
         val = float(val)
         if name == "mass":
-            d["axis"]["mass"] = max(val, 1e-6)
+            continue
         elif "." in name:
             a, k = name.split(".")
             f[a][k] = val

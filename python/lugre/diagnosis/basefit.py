@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import units as U
 from ..model import Model
 from . import residual as R
 from .base import apply_base, get_base
@@ -389,9 +390,10 @@ def identify(recording: Any, *, mass: float | None = None, force_constant: float
     from ..exceptions import PassivityWarning
     from .evaluation import as_recording
 
-    with warnings.catch_warnings():  # the starts and trial models; the result is checked
-        warnings.simplefilter("ignore", PassivityWarning)
-        res = _identify(as_recording(recording), mass, force_constant, cutoff_hz, controller,
+    rec = as_recording(recording)
+    with warnings.catch_warnings(), U.axis(rec.meta.get("axis_kind", "linear")):
+        warnings.simplefilter("ignore", PassivityWarning)  # (the starts and trial models)
+        res = _identify(rec, mass, force_constant, cutoff_hz, controller,
                         backend, profiles)
     return replace(res, model=Model(res.model.to_dict()))  # warns once if not passive
 

@@ -83,7 +83,7 @@ def fit_model(
                   tolerance=IDENTIFY_TOLERANCE, backend=backend)
     model = dg.augmented_model()
     if mass is not None:
-        model = model.replace(axis={**model.axis, "mass": float(mass)})
+        model = model.with_axis(mass=float(mass))
     if not dg.findings:
         return res.model, replace(res, diagnosis=dg)
     # the base fitted again with the effects found held in it: the search refits the

@@ -10,6 +10,7 @@ import time
 import warnings
 from typing import Any
 
+from .. import units as U
 from ..exceptions import PassivityWarning
 from ..io import Recording
 from ..model import Model, _as_model
@@ -117,7 +118,7 @@ def diagnose(
                    candidates=None if candidates is None else tuple(candidates),
                    screw_lead=screw_lead, free_mass=free_mass, tolerance=tolerance,
                    backend=backend)
-    with warnings.catch_warnings():  # the trial models of the search and the refits
+    with warnings.catch_warnings(), U.axis(model.kind):  # (the trial models' warnings)
         warnings.simplefilter("ignore", PassivityWarning)
         dg = _run(rec, model, opts)
         # the base is a starting point: when the record puts it far from where it was

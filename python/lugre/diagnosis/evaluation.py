@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import units as U
 from ..exceptions import InputError
 from ..io import Recording
 from ..model import Model, _as_model
@@ -115,6 +116,11 @@ def evaluate(recording: Any, model: Any, *, cutoff_hz: float | None = None,
     """
     rec = as_recording(recording)
     m = _as_model(model)
+    with U.axis(m.kind):
+        return _evaluate(rec, m, cutoff_hz, backend)
+
+
+def _evaluate(rec: Any, m: Model, cutoff_hz: float | None, backend: Any) -> dict[str, Any]:
     R.check_recording(rec, m)
     sig = R.prepare(rec, m, cutoff_hz=cutoff_hz, backend=backend)
     R.check_units(sig, m)

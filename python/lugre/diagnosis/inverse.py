@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import DataError
-from ..model import Model
+from ..model import Model, axis_document
 from . import residual as R
 from .evaluation import as_recording
 from .options import IDENTIFY_TOLERANCE
@@ -27,6 +27,7 @@ def fit_inverse_dynamics(
     controller: dict[str, Any] | None = None,
     backend: Any = "core",
     sliding: float | None = None,
+    axis_kind: str | None = None,
 ) -> Model:
     """Fit a LuGre axis model by robust least squares on the inverse dynamics.
 
@@ -63,6 +64,10 @@ def fit_inverse_dynamics(
         than ten encoder counts per sample): where the axis slides, the static curve is
         the friction; where it sticks, the friction is whatever the drive pushes with.
         Default: every sample.
+    axis_kind : {"linear", "rotary"}, optional
+        The axis the model describes (CONTRACT, "Rotary axes"); default the
+        recording's (``meta["axis_kind"]``, set when its positions were read in rad or
+        deg), else linear.
 
     Returns
     -------
@@ -70,9 +75,9 @@ def fit_inverse_dynamics(
     """
     rec = as_recording(recording)
     R.check_recording(rec)
+    kind = axis_kind or rec.meta.get("axis_kind", "linear")
     proto = Model.paper().replace(
-        axis={"mass": 1.0, "force_constant": float(force_constant)}, effects=[],
-        controller=None)
+        axis=axis_document(kind, 1.0, force_constant), effects=[], controller=None)
     sig = R.prepare(rec, proto, cutoff_hz=cutoff_hz, backend=backend)
     v = sig.v
     m = sig.mask
@@ -107,8 +112,9 @@ def fit_inverse_dynamics(
     off = 0 if mass is not None else 1
     mm = float(mass) if mass is not None else float(b[0])
     if not mm > 0:
-        raise DataError(f"the inverse-dynamics fit gives a mass of {mm:.3g} kg: the record "
-                        "does not excite the inertia; give the mass")
+        raise DataError(f"the inverse-dynamics fit gives a mass of {mm:.3g} "
+                        f"{'kg m^2' if kind == 'rotary' else 'kg'}: the record does not "
+                        "excite the inertia; give the mass (--mass)")
     fcp, s2p, fcn, s2n = (float(b[off + k]) for k in range(4))
     dp = float(b[off + 4]) if vs is not None else 0.0
     dn = float(b[off + 5]) if vs is not None else 0.0
@@ -120,7 +126,7 @@ def fit_inverse_dynamics(
         sigma0 = fsmax / max(10 * q, 1e-5)
     sigma1 = 0.05 * math.sqrt(sigma0 * mm)
     doc = {
-        "axis": {"mass": mm, "force_constant": float(force_constant)},
+        "axis": axis_document(kind, mm, force_constant),
         "friction": {
             "model": "lugre", "sigma0": float(sigma0), "sigma1": float(sigma1),
             "positive": {"fc": fcp, "fs": fcp + max(dp, 0.0), "sigma2": max(s2p, 0.0),

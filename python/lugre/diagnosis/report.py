@@ -12,6 +12,7 @@ import numpy as np
 from .. import units as U
 from .._words import plain_text
 from ..model import Model
+from ..units import axis_units
 from ..vocabulary import is_timing
 from .candidates.lag import timing_words
 
@@ -149,8 +150,10 @@ class Diagnosis:
         return self.augmented
 
     def to_dict(self) -> dict[str, Any]:
-        """REPORT.json (CONTRACT shape, plus ``noise``, ``base``, ``located``, ...)."""
+        """REPORT.json (CONTRACT shape, plus ``noise``, ``base``, ``located``, ...);
+        ``axis`` says the kind of axis and the units of its numbers."""
         d: dict[str, Any] = {
+            "axis": axis_units(self.model.kind),
             "verdict": self.verdict,
             "findings": [f.to_dict() for f in self.findings],
             "fit": _plain(self.fit),
@@ -177,7 +180,11 @@ class Diagnosis:
         return json.dumps(self.to_dict(), indent=indent)
 
     def summary(self) -> str:
-        """A plain-text report for a control engineer."""
+        """A plain-text report for a control engineer, in the axis's units."""
+        with U.axis(self.model.kind):
+            return self._summary()
+
+    def _summary(self) -> str:
         from .evidence import effect_words
 
         lines: list[str] = [self.verdict] if self.verdict else []
@@ -222,7 +229,7 @@ class Diagnosis:
                     f"{a} {U.fmt(v, U.unit_of(f.effect, a))}" for a, v in f.parameters.items()
                     if a not in ("positions", "scale")
                 )
-            wh = ", ".join(f"{a} {U.fmt_range(v[0], v[1], U.WHERE_UNITS.get(a, ('', 1.0)))}"
+            wh = ", ".join(f"{a} {U.fmt_range(v[0], v[1], U.where_unit(a))}"
                            if isinstance(v, (list, tuple)) and len(v) == 2 else f"{a} {_fmt(v)}"
                            for a, v in f.where.items() if v is not None)
             line = (f"{k}. {f.effect}{' (' + ps + ')' if ps else ''} explains {U.percent(f.explained)} of "

@@ -45,7 +45,7 @@ def _list_summary(name: str, vals: list[float], unit: tuple[str, float],
     if name == "scale" and isinstance(pos, (list, tuple)) and len(pos) == len(vals):
         k = max(range(len(vals)), key=lambda j: abs(vals[j] - 1.0))
         text += (f"; largest change ×{U.num(vals[k])} at "
-                 f"{U.fmt(pos[k], U.POSITION)}")
+                 f"{U.fmt(pos[k], U.position_unit())}")
     return text
 
 
@@ -115,7 +115,7 @@ def _where_text(where: dict[str, Any] | None) -> str:
         return "everywhere in the record (not confined)"
     parts = []
     for key in ("position", "time", "velocity"):
-        txt = _ranges_text(where.get(key), U.WHERE_UNITS[key])
+        txt = _ranges_text(where.get(key), U.where_unit(key))
         if txt:
             parts.append(f"{key} {txt}")
     d = where.get("direction")
@@ -364,6 +364,15 @@ def diagnosis_page(report: dict[str, Any], data: dict[str, Any] | None = None, *
     resampled : str, optional
         How the recording was resampled, said on the page.
     """
+    kind = (report.get("axis") or {}).get("kind", "linear")
+    with U.axis(kind if isinstance(kind, str) else "linear"):
+        return _diagnosis_page(report, data, source=source, model=model, holdout=holdout,
+                               resampled=resampled, title=title)
+
+
+def _diagnosis_page(report: dict[str, Any], data: dict[str, Any] | None, *,
+                    source: str | None, model: str | None, holdout: str | None,
+                    resampled: str | None, title: str | None) -> str:
     findings = report.get("findings") or []
     fit = report.get("fit") or {}
     noise = report.get("noise") or {}

@@ -22,14 +22,14 @@ def _model_rows(doc: dict[str, Any]) -> list[list[str]]:
     fr = doc.get("friction") or {}
     for name in ("mass", "force_constant"):
         if name in axis:
-            rows.append([name.replace("_", " "), escape(U.fmt(axis[name], U.BASE_UNITS[name]))])
+            rows.append([name.replace("_", " "), escape(U.fmt(axis[name], U.base_unit(name)))])
     for name in ("sigma0", "sigma1"):
         if name in fr:
-            rows.append([name, escape(U.fmt(fr[name], U.BASE_UNITS[name]))])
+            rows.append([name, escape(U.fmt(fr[name], U.base_unit(name)))])
     for d in ("positive", "negative"):
         for name, val in (fr.get(d) or {}).items():
             rows.append([f"{name} ({'v ≥ 0' if d == 'positive' else 'v < 0'})",
-                         escape(U.fmt(val, U.BASE_UNITS.get(name, ('', 1.0))))])
+                         escape(U.fmt(val, U.base_unit(name)))])
     return rows
 
 
@@ -70,7 +70,7 @@ def static_fit_page(fit: Any, v: Any, F: Any, model: dict[str, Any], *,
     for d, label in (("positive", "v ≥ 0"), ("negative", "v < 0")):
         df = getattr(fit, d)
         for name, val in df.params.items():
-            unit = U.BASE_UNITS.get(name, ("", 1.0))
+            unit = U.base_unit(name)
             lo, hi = df.ci95.get(name, (None, None))
             rows.append([escape(f"{name} ({label})"), escape(U.fmt(val, unit)),
                          escape(U.fmt_range(lo, hi, unit)) if lo is not None else "–"])
@@ -110,7 +110,14 @@ def fit_page(model: dict[str, Any], rec: Any = None, *, source: str | None = Non
              nrmse: dict[str, float | None] | None = None,
              first: dict[str, Any] | None = None) -> str:
     """``lugre fit``: the identified model, how well it explains the record, its friction
-    curve."""
+    curve, in the units of the model's axis."""
+    rotary = (model.get("axis") or {}).get("kind") == "rotary"
+    with U.axis("rotary" if rotary else "linear"):
+        return _fit_page(model, rec, source=source, nrmse=nrmse, first=first)
+
+
+def _fit_page(model: dict[str, Any], rec: Any, *, source: str | None,
+              nrmse: dict[str, float | None] | None, first: dict[str, Any] | None) -> str:
     body = []
     ident = model.get("identification") or {}
     if ident.get("summary"):

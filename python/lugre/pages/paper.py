@@ -43,7 +43,7 @@ def _paper_rows(rows: dict[str, Any], label: str = "") -> list[list[str]]:
     for name, r in rows.items():
         if not isinstance(r, dict):
             continue
-        unit = U.BASE_UNITS.get(name, ("", 1.0))
+        unit = U.base_unit(name)
         ci = r.get("ci95") or [None, None]
         truth = r.get("truth")
         est = r.get("estimate")
