@@ -196,3 +196,24 @@ def test_fit_with_effects_refits_the_base_with_them():
         assert model.friction[d]["fs"] == pytest.approx(fs, rel=0.05)
         assert model.friction[d]["vs"] == pytest.approx(0.01, rel=0.1)
     assert not fit.floor_words()[1]  # at the noise floor once the cogging is in
+
+
+def test_a_non_passive_fit_holds_sigma1_at_the_bound_and_says_so(fitted):
+    """sigma1 beyond 4*sigma2*fc/(fs - fc) makes the friction map non-passive: the fit
+    holds it at the bound, keeps what it had found, and its note says so."""
+    from dataclasses import replace
+
+    from lugre.diagnosis.basefit import _passive
+    from lugre.diagnosis.fitreport import undetermined_notes
+
+    res = fitted
+    bound = min(res.model.passivity_bound())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        loose = replace(res, model=res.model.with_friction(sigma1=3.0 * bound))
+    held = _passive(loose)
+    assert held.model.is_passive and held.model.sigma1 == pytest.approx(bound)
+    assert held.profiles["sigma1"]["fitted"] == pytest.approx(3.0 * bound)
+    note = [n for n in undetermined_notes(held) if n.startswith("sigma1")]
+    assert note and "passivity bound" in note[0] and "not passive" in note[0]
+    assert _passive(res) is res  # a passive fit is returned as it is

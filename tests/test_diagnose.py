@@ -927,3 +927,18 @@ def test_a_force_record_reads_its_dead_band_as_a_force():
     (db_i,) = [h for h in dg_i.could_not_reveal if h["effect"] == "deadband"]
     assert db_i["unit"] == "A" and db_i["smallest"] * bel.force_constant == pytest.approx(
         db["smallest"], rel=0.05)
+
+
+def test_a_record_that_barely_moves_back_is_refused_with_its_counts():
+    """A move one way with a few samples of jitter the other way (a trapezoidal move of
+    a robot joint, logged with repeated samples): one direction's friction cannot be
+    read, so the fit and the diagnosis refuse it and say which direction and how much."""
+    t = np.arange(4000) * 1e-3
+    x = 0.2 * np.clip((t - 0.5) / 3.0, 0.0, 1.0)
+    x[1000:1020:4] -= 2e-4  # a few jittery steps back
+    rec = lugre.Recording(t=t, x=x, i=np.ones_like(t))
+    with pytest.raises(DataError, match=r"one direction only: \d+ of its \d+ moving samples "
+                                        r"go the negative way"):
+        lugre.fit_model(rec, force_constant=25.0)
+    with pytest.raises(DataError, match="record a move back"):
+        diagnose(rec, lugre.Model.paper())

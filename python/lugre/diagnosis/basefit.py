@@ -395,7 +395,22 @@ def identify(recording: Any, *, mass: float | None = None, force_constant: float
         warnings.simplefilter("ignore", PassivityWarning)  # (the starts and trial models)
         res = _identify(rec, mass, force_constant, cutoff_hz, controller,
                         backend, profiles)
-    return replace(res, model=Model(res.model.to_dict()))  # warns once if not passive
+    return _passive(res)
+
+
+def _passive(res: BaseFitResult) -> BaseFitResult:
+    """The fit with sigma1 held at the passivity bound ``4*sigma2*fc/(fs - fc)`` of
+    its friction when it came out beyond it (a non-passive friction map can feed energy
+    into the axis; the record then also leaves sigma1 loose): said in its profile."""
+    m = res.model
+    if m.is_passive:
+        return res
+    bound = min(m.passivity_bound())
+    prof = dict(res.profiles)
+    p = dict(prof.get("sigma1") or {"ci95": [None, None]})
+    p.update(value=bound, fitted=m.sigma1, determined=False, how="passivity bound")
+    prof["sigma1"] = p
+    return replace(res, model=m.with_friction(sigma1=bound), profiles=prof)
 
 
 def _identify(rec: Any, mass: float | None, force_constant: float, cutoff_hz: float | None,

@@ -79,6 +79,13 @@ def undetermined_notes(fit: BaseFitResult) -> list[str]:
                        f"{what}: the fit is as good within the noise. Would determine it: "
                        f"{_WOULD[key]}")
             continue
+        if p["how"] == "passivity bound":
+            out.append(f"{label(name)} = {val} is held at the passivity bound "
+                       "4*sigma2*fc/(fs - fc) of the friction: the fit gave "
+                       f"{p['fitted']:.4g} {fit_unit(name)}, beyond which the friction map "
+                       "is not passive (it could feed energy into the axis). Would "
+                       f"determine it: {_WOULD[key]}")
+            continue
         if p["how"] == "no hump":
             out.append(f"{label(name)} = {val} is NOT determined: the fit found no Stribeck "
                        "hump in this direction (fs = fc), so vs does nothing. Would show a "

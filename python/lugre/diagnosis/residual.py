@@ -268,11 +268,35 @@ def check_recording(rec: Recording, model: Model | None = None) -> None:
                 UnitsWarning,
                 stacklevel=3,
             )
-    if not (np.any(v > 0) and np.any(v < 0)):
-        raise DataError(
-            "the recording moves in one direction only: the diagnosis needs motion in "
-            "both directions to separate friction from other forces"
-        )
+    _require_both_directions(rec, med)
+
+
+#: Least share of the moving samples, and least count, that each direction must have.
+MIN_DIRECTION_SHARE = 0.02
+MIN_DIRECTION_SAMPLES = 50
+
+
+def _require_both_directions(rec: Recording, dt: float) -> None:
+    """Refuse a record that slides in one direction only (or nearly): friction is
+    identified per direction, and a direction seen in a few jittery samples gives
+    levels of any size. Sliding is read on the position's change over ten samples,
+    beyond a twentieth of the largest speed."""
+    k = min(10, max(1, len(rec) // 100))
+    v = (rec.x[k:] - rec.x[:-k]) / (k * dt)
+    moving = np.abs(v) > 0.05 * float(np.max(np.abs(v)))
+    pos, neg = int(np.sum(moving & (v > 0))), int(np.sum(moving & (v < 0)))
+    few = min(pos, neg)
+    if few >= max(MIN_DIRECTION_SAMPLES, MIN_DIRECTION_SHARE * (pos + neg)):
+        return
+    side, other = ("negative", "positive") if neg < pos else ("positive", "negative")
+    raise DataError(
+        f"the recording moves in one direction only: {few} of its {pos + neg} moving "
+        f"samples go the {side} way (at least {MIN_DIRECTION_SAMPLES} and "
+        f"{100 * MIN_DIRECTION_SHARE:.0f} % are needed). Friction is identified per "
+        f"direction, so the {side} direction's levels cannot be read from it: record a "
+        f"move back as well (a reversal at the same speeds), or fit the {other} "
+        "direction from a record that holds both"
+    )
 
 
 def command_hold(model: Model, dt: float | None = None) -> float:
