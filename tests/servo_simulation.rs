@@ -421,3 +421,220 @@ fn drag_steady_force() {
         );
     }
 }
+
+/// The seed paper's axis in rotary units (the same numbers: inertia 25 kg m^2, torque
+/// constant 25 N m/A, friction levels in N m), for `gravity`.
+fn rotary(effects: &str, controller: &str) -> Model {
+    let m = Model::from_json(&format!(
+        r#"{{"axis": {{"kind": "rotary", "inertia": 25.0, "torque_constant": 25.0}},
+        "friction": {{"sigma0": 1e5, "sigma1": 31.62,
+          "positive": {{"fc": 28.7, "fs": 60.2, "sigma2": 332.5, "vs": 0.01}},
+          "negative": {{"fc": 28.5, "fs": 60.1, "sigma2": 333.0, "vs": 0.01}}}},
+        "effects": [{effects}] {controller}}}"#
+    ))
+    .unwrap();
+    assert!(m.is_rotary());
+    m
+}
+
+/// The amplifier's limit clips the force, after the dead band, and leaves the recorded
+/// current (the command) as it was.
+#[test]
+fn current_limit_clips_the_force_not_the_record() {
+    let m = paper(
+        r#"{"effect": "current_limit", "current": 2.0}, {"effect": "deadband", "current": 0.5}"#,
+        "",
+    );
+    let t = grid(401, 1e-3);
+    let i: Vec<f64> = t
+        .iter()
+        .map(|&s| 4.0 * (2.0 * std::f64::consts::PI * 3.0 * s).sin())
+        .collect();
+    let r = sim(&m, &t, Drive::Current(&i), Integrator::Exact, 1, 0.0);
+    assert_eq!(r.i, i, "the recorded current is the command");
+    for (k, (&f, &c)) in r.force.iter().zip(&i).enumerate() {
+        let db = if c > 0.5 {
+            c - 0.5
+        } else if c < -0.5 {
+            c + 0.5
+        } else {
+            0.0
+        };
+        assert_eq!(f, 25.0 * db.clamp(-2.0, 2.0), "sample {k}");
+    }
+    assert_eq!(r.force.iter().fold(0.0f64, |a, f| a.max(f.abs())), 50.0);
+    // closed loop: the controller asks for more than the limit, the force stays within
+    let m = paper(r#"{"effect": "current_limit", "current": 3.0}"#, PID);
+    let t = grid(6001, 1e-4);
+    let xr: Vec<f64> = t
+        .iter()
+        .map(|&s| 0.02 * (2.0 * std::f64::consts::PI * 1.5 * s).sin())
+        .collect();
+    let r = sim(&m, &t, Drive::Position(&xr), Integrator::Exact, 1, 0.0);
+    assert!(r.i.iter().any(|i| i.abs() > 3.5));
+    assert!(r.force.iter().all(|f| f.abs() <= 75.0));
+}
+
+/// The motor force carries the ripple of the motor's position, scaled with the current.
+#[test]
+fn force_ripple_follows_the_position_and_the_current() {
+    let (a, pitch, phase) = (0.05, 0.01, 0.7);
+    let m = paper(
+        &format!(
+            r#"{{"effect": "force_ripple", "amplitude": {a}, "pitch": {pitch}, "phase": {phase}}}"#
+        ),
+        "",
+    );
+    let t = grid(301, 1e-3);
+    for i0 in [3.0, -4.0] {
+        let i = vec![i0; t.len()];
+        let r = sim(&m, &t, Drive::Current(&i), Integrator::Exact, 1, 0.0);
+        assert!(
+            r.x.last().unwrap().abs() > 2.0 * pitch,
+            "moves over pitches"
+        );
+        let w = 2.0 * std::f64::consts::PI / pitch;
+        for k in 1..t.len() {
+            let want = 25.0 * i0 * (1.0 + a * (w * r.x[k] + phase).sin());
+            assert_eq!(r.force[k].to_bits(), want.to_bits(), "sample {k}");
+        }
+    }
+}
+
+/// A load-dependent friction raises the sliding friction by `coefficient*|F_m|`: at
+/// constant speed the motor force is the Stribeck force over `1 - coefficient`.
+#[test]
+fn load_friction_steady_force() {
+    let c = 0.15;
+    let m = paper(
+        &format!(r#"{{"effect": "load_friction", "coefficient": {c}}}"#),
+        PID,
+    );
+    let t = grid(20_001, 1e-4);
+    for vr in [0.2, -0.05] {
+        let xr: Vec<f64> = t.iter().map(|&s| vr * s).collect();
+        let r = sim(&m, &t, Drive::Position(&xr), Integrator::Exact, 1, 0.0);
+        let n = t.len();
+        let f_motor = r.force[n - 2000..].iter().sum::<f64>() / 2000.0;
+        let want = m.friction.stribeck(vr) / (1.0 - c);
+        assert!(
+            (f_motor - want).abs() < 1e-3 * want.abs(),
+            "v {vr}: motor force {f_motor} vs {want}"
+        );
+        // and the recorded friction is the raised one
+        let f_fric = r.friction[n - 2000..].iter().sum::<f64>() / 2000.0;
+        assert!(
+            (f_fric - want).abs() < 1e-3 * want.abs(),
+            "{f_fric} vs {want}"
+        );
+    }
+}
+
+/// A joint turning slowly under its load's weight: the motor torque is the friction
+/// plus `torque*sin(x + phase)`.
+#[test]
+fn gravity_on_a_turning_joint() {
+    let (tq, phase) = (40.0, 0.3);
+    let m = rotary(
+        &format!(r#"{{"effect": "gravity", "torque": {tq}, "phase": {phase}}}"#),
+        PID,
+    );
+    let t = grid(40_001, 1e-4);
+    let wr = 1.0; // rad/s, four radians
+    let xr: Vec<f64> = t.iter().map(|&s| wr * s).collect();
+    let r = sim(&m, &t, Drive::Position(&xr), Integrator::Exact, 1, 0.0);
+    let mut worst = 0.0f64;
+    for k in 5000..t.len() {
+        let want = m.friction.stribeck(wr) + tq * (r.x[k] + phase).sin();
+        worst = worst.max((r.force[k] - want).abs());
+    }
+    // (what is left is the inertia of the PID's tracking error)
+    assert!(worst < 0.01 * tq, "{worst}");
+}
+
+/// The force residual of the inverse dynamics (`lugre::inverse`) of a noise-free record
+/// simulated at the sampling rate (each sample a plant step: the acceleration is the
+/// step's), with `model`; its rms over every sample but the last.
+fn inverse_residual_rms(record: &lugre::servo::SimResult, t: &[f64], model: &Model) -> f64 {
+    use lugre::inverse::{Lowpass, Record};
+    let n = t.len();
+    let dt = t[1] - t[0];
+    let mut a: Vec<f64> = (0..n - 1)
+        .map(|k| (record.v[k + 1] - record.v[k]) / dt)
+        .collect();
+    a.push(a[n - 2]);
+    let fm: Vec<f64> = record
+        .i
+        .iter()
+        .map(|i| model.axis.force_constant * i)
+        .collect();
+    let rec = Record::new(
+        t.to_vec(),
+        record.x.clone(),
+        record.x.clone(),
+        record.v.clone(),
+        a,
+        fm.clone(),
+        fm,
+        dt,
+        Lowpass::identity(),
+    )
+    .unwrap();
+    let r = rec.residual(model).unwrap();
+    (r[..n - 1].iter().map(|x| x * x).sum::<f64>() / (n - 1) as f64).sqrt()
+}
+
+/// Each new effect simulated, then read back by the inverse dynamics: with the effect in
+/// the model the residual is what the two discretisations leave (the bristles advanced
+/// with the velocity held against the interval's mean), a small share of the residual
+/// without it.
+#[test]
+fn inverse_dynamics_reads_back_the_simulated_effects() {
+    let t = grid(8001, 1e-4);
+    let xr: Vec<f64> = t
+        .iter()
+        .map(|&s| 0.02 * (2.0 * std::f64::consts::PI * 1.5 * s).sin())
+        .collect();
+    let turn: Vec<f64> = t.iter().map(|&s| 1.0 * s).collect();
+    let cases = [
+        (r#"{"effect": "load_friction", "coefficient": 0.15}"#, false),
+        (
+            r#"{"effect": "force_ripple", "amplitude": 0.05, "pitch": 0.01, "phase": 0.7}"#,
+            false,
+        ),
+        (r#"{"effect": "current_limit", "current": 3.0}"#, false),
+        (
+            r#"{"effect": "gravity", "torque": 40.0, "phase": 0.3}"#,
+            true,
+        ),
+        (
+            r#"{"effect": "deadband", "current": 0.2}, {"effect": "current_limit", "current": 3.0},
+               {"effect": "force_ripple", "amplitude": 0.05, "pitch": 0.01},
+               {"effect": "load_friction", "coefficient": 0.1},
+               {"effect": "cogging", "amplitude": 3.0, "pitch": 0.025}"#,
+            false,
+        ),
+    ];
+    for (effects, turning) in cases {
+        let (truth, without, drive) = if turning {
+            (rotary(effects, PID), rotary("", PID), &turn)
+        } else {
+            (paper(effects, PID), paper("", PID), &xr)
+        };
+        let r = sim(
+            &truth,
+            &t,
+            Drive::Position(drive),
+            Integrator::Exact,
+            1,
+            0.0,
+        );
+        let with = inverse_residual_rms(&r, &t, &truth);
+        let plain = inverse_residual_rms(&r, &t, &without);
+        // (measured: 0.02-0.04 N with the effect, 3.1-1471 N without)
+        assert!(
+            with < 0.1 && with < 0.02 * plain,
+            "{effects}: {with} against {plain}"
+        );
+    }
+}

@@ -45,7 +45,40 @@ EFFECTS = {
                   {"effect": "mass", "delta": 1.5},
                   {"effect": "position_friction", "positions": [-0.1, 0.1],
                    "scale": [0.95, 1.05]}],
+    # the actuator in its order (dead band, limit, lag, ripple) and the friction it raises
+    "actuator+load": [{"effect": "force_ripple", "amplitude": 0.06, "pitch": 0.02,
+                       "phase": 0.5},
+                      {"effect": "current_limit", "current": 4.0},
+                      {"effect": "deadband", "current": 0.1},
+                      {"effect": "current_lag", "bandwidth": 150.0},
+                      {"effect": "load_friction", "coefficient": 0.12},
+                      {"effect": "force_ripple", "amplitude": -0.02, "pitch": 0.007}],
+    "load+shape+scales": [{"effect": "load_friction", "coefficient": 0.2},
+                          {"effect": "stribeck_shape", "exponent": 0.8},
+                          {"effect": "drift", "gain": 0.1, "time_constant": 2.0},
+                          {"effect": "delay", "seconds": 7e-4}],
+    "limit": [{"effect": "current_limit", "current": 3.0}],
+    "resonance+load": [{"effect": "resonance", "frequency": 22.0, "damping_ratio": 0.04,
+                        "load_fraction": 0.75},
+                       {"effect": "load_friction", "coefficient": 0.1},
+                       {"effect": "force_ripple", "amplitude": 0.05, "pitch": 0.02},
+                       {"effect": "cogging", "amplitude": 2.0, "pitch": 0.025}],
+    # (on the record read as a joint's, in rad: gravity acts on rotary axes only)
+    "rotary:gravity": [{"effect": "gravity", "torque": 30.0, "phase": 0.4},
+                       {"effect": "offset", "force": 2.0}],
+    "rotary:gravity+resonance": [{"effect": "resonance", "frequency": 22.0,
+                                  "damping_ratio": 0.04, "load_fraction": 0.75},
+                                 {"effect": "gravity", "torque": 30.0}],
 }
+
+
+def with_effects(model, case):
+    """``model`` with the effects of ``case`` (a ``rotary:`` case on the same axis read
+    as a joint's)."""
+    if not case.startswith("rotary:"):
+        return model.replace(effects=EFFECTS[case])
+    axis = {"kind": "rotary", "inertia": model.mass, "torque_constant": model.force_constant}
+    return model.replace(axis=axis, effects=EFFECTS[case])
 
 KERNELS = ("base_friction", "effect_force", "model_force", "motor_force", "residual")
 
@@ -63,13 +96,13 @@ def _rel(a: np.ndarray, b: np.ndarray) -> float:
 @pytest.mark.parametrize("case", sorted(EFFECTS))
 def test_kernels_twins(pair, case):
     sig, sigr, model = pair
-    m = model.replace(effects=EFFECTS[case])
+    m = with_effects(model, case)
     for name in KERNELS:
         a = getattr(sig.kernel, name)(m)
         b = getattr(sigr.kernel, name)(m)
         assert a.shape == b.shape == (len(sig),)
         assert _rel(a, b) <= 1e-12, (case, name, _rel(a, b))
-    if case == "resonance":
+    if "resonance" in case:
         assert _rel(sig.kernel.coupling_force(m), sigr.kernel.coupling_force(m)) <= 1e-12
     fa, ja, na = sig.kernel.base_sensitivities(m, NAMES)
     fb, jb, nb = sigr.kernel.base_sensitivities(m, NAMES)
@@ -97,11 +130,13 @@ def test_kernels_twins_on_independent_plant():
             np.testing.assert_array_equal(a, b, err_msg=name)
 
 
-def test_sensitivities_are_derivatives(pair):
-    """Each column against a central difference of the filtered LuGre force."""
+@pytest.mark.parametrize("load", [[], EFFECTS["actuator+load"]], ids=["plain", "load"])
+def test_sensitivities_are_derivatives(pair, load):
+    """Each column against a central difference of the filtered LuGre force (the levels
+    raised by a load_friction under the motor force included)."""
     sig, _, model = pair
     m = model.replace(effects=EFFECTS["scales"] + [{"effect": "stribeck_shape",
-                                                      "exponent": 1.4}])
+                                                      "exponent": 1.4}] + load)
     _, jac, _ = sig.kernel.base_sensitivities(m, NAMES)
     d = m.to_dict()
     for j, name in enumerate(NAMES):

@@ -611,6 +611,150 @@ def test_new_effects_save_round_trip(tmp_path):
                                   lugre.simulate(m, t, 0.01 * t).x)
 
 
+# ---- gravity, load_friction, force_ripple, current_limit -----------------------------------
+
+#: A rotary axis with the seed paper's numbers (inertia 25 kg m^2, torque constant
+#: 25 N m/A, the friction levels in N m): gravity acts on rotary axes only.
+ROTARY_AXIS = {"kind": "rotary", "inertia": 25.0, "torque_constant": 25.0}
+RIPPLE = {"effect": "force_ripple", "amplitude": 0.05, "pitch": 0.01, "phase": 0.7}
+DRIVE_EFFECTS = {
+    "rotary:gravity": [{"effect": "gravity", "torque": 40.0, "phase": 0.3}],
+    "load_friction": [{"effect": "load_friction", "coefficient": 0.15}],
+    "force_ripple": [RIPPLE],
+    "current_limit": [{"effect": "current_limit", "current": 2.5}],
+    # the whole actuator, two ripples, a lag and the friction it raises, on two masses
+    "actuator+resonance": [
+        {**RESONANCE, "frequency": 150.0, "damping_ratio": 0.2},
+        {"effect": "deadband", "current": 0.1}, {"effect": "current_limit", "current": 2.5},
+        RIPPLE, {"effect": "force_ripple", "amplitude": -0.02, "pitch": 0.004},
+        EFFECTS["current_lag"][0], {"effect": "load_friction", "coefficient": 0.1},
+        {"effect": "stribeck_shape", "exponent": 1.4}],
+    "load+delay+drift": [{"effect": "load_friction", "coefficient": 0.2},
+                         EFFECTS["delay"][0], EFFECTS["drift"][0]],
+    "rotary:gravity+resonance+load": [
+        RESONANCE, {"effect": "gravity", "torque": 40.0},
+        {"effect": "load_friction", "coefficient": 0.1}],
+}
+
+
+def drive_model(name):
+    d = lugre.Model.paper().to_dict()
+    d["effects"] = DRIVE_EFFECTS[name]
+    if name.startswith("rotary:"):
+        d["axis"] = dict(ROTARY_AXIS)
+    return lugre.Model.from_dict(d)
+
+
+def drive_reference(name, t):
+    """A turn of the joint (1 rad/s) or the linear axis's back-and-forth."""
+    if name.startswith("rotary:"):
+        return 1.0 * t
+    return 0.02 * np.sin(2 * np.pi * 1.5 * t)
+
+
+@pytest.mark.parametrize("name", sorted(DRIVE_EFFECTS))
+@pytest.mark.parametrize("integrator", ["exact", "rk4"])
+def test_drive_effects_pid_twins_bit_identical(name, integrator):
+    m = drive_model(name)
+    t = np.arange(0, 0.4, 1e-4)
+    x_ref = drive_reference(name, t)
+    a = lugre.simulate(m, t, x_ref, integrator=integrator)
+    b = ref.simulate(m, t, x_ref, integrator=integrator)
+    assert np.ptp(a.x) > 1e-3  # the axis moves
+    assert max_diff(a, b) == 0.0
+
+
+@pytest.mark.parametrize("name", sorted(DRIVE_EFFECTS))
+@pytest.mark.parametrize("integrator", ["exact", "rk4"])
+def test_drive_effects_open_loop_twins_bit_identical(name, integrator):
+    m = drive_model(name)
+    t = np.arange(0, 0.3, 1e-3)
+    i = 3.0 * np.sin(2 * np.pi * 4 * t)
+    a = lugre.simulate(m, t, current=i, integrator=integrator, substeps=4)
+    b = ref.simulate(m, t, current=i, integrator=integrator, substeps=4)
+    assert np.ptp(a.x) > 1e-3
+    assert max_diff(a, b) == 0.0
+
+
+@pytest.mark.parametrize("loop", [{"bandwidth_hz": 800.0},
+                                  {"resistance": 1.2, "inductance": 0.01874,
+                                   "back_emf": 25.0, "bandwidth_hz": 1000.0}],
+                         ids=["first_order", "rl"])
+def test_drive_effects_with_current_loop_and_feedforward_twins(loop):
+    """Behind a current loop the friction follows the actual current's force, which the
+    loop moves within each plant step (the sample's friction is not the step's)."""
+    d = drive_model("actuator+resonance").to_dict()
+    d["axis"]["current_loop"] = loop
+    d["controller"]["feedforward"] = {"type": "lugre"}
+    m = lugre.Model.from_dict(d)
+    t = np.arange(0, 0.3, 3.3e-4)
+    x_ref = 0.01 * np.sin(2 * np.pi * 2 * t)
+    a = lugre.simulate(m, t, x_ref, substeps=2)
+    b = ref.simulate(m, t, x_ref, substeps=2)
+    assert max_diff(a, b) == 0.0
+
+
+def test_drive_effects_batch_twins():
+    t = np.arange(0, 0.1, 1e-4)
+    models = [drive_model(k) for k in ("force_ripple", "load_friction", "current_limit")]
+    a = lugre.simulate_batch(models, t, 0.01 * np.sin(2 * np.pi * 5 * t))
+    b = ref.simulate_batch(models, t, 0.01 * np.sin(2 * np.pi * 5 * t))
+    for r, s in zip(a, b):
+        assert_same_result(r, s)
+
+
+BAD_DRIVE_EFFECTS = [
+    # (path, class, effects, rotary axis)
+    ("effects[1].effect", lugre.ModelError,
+     [{"effect": "offset", "force": 1.0}, {"effect": "gravity", "torque": 2.0}], False),
+    ("effects[0].torque", lugre.ModelError, [{"effect": "gravity", "phase": 0.1}], True),
+    ("effects[0].amplitude", lugre.ParameterError, [{**RIPPLE, "amplitude": 1.0}], False),
+    ("effects[0].amplitude", lugre.ParameterError, [{**RIPPLE, "amplitude": -1.2}], False),
+    ("effects[0].pitch", lugre.ParameterError, [{**RIPPLE, "pitch": 0.0}], False),
+    ("effects[0].coefficient", lugre.ParameterError,
+     [{"effect": "load_friction", "coefficient": -0.1}], False),
+    ("effects[0].current", lugre.ParameterError,
+     [{"effect": "current_limit", "current": 0.0}], False),
+    ("effects[0].current", lugre.ModelError, [{"effect": "current_limit"}], False),
+    ("effects", lugre.ModelError, [{"effect": "gravity", "torque": 1.0},
+                                   {"effect": "gravity", "torque": 2.0}], True),
+    ("effects", lugre.ModelError, [{"effect": "load_friction", "coefficient": 0.1},
+                                   RIPPLE, {"effect": "load_friction", "coefficient": 0.2}],
+     False),
+    ("effects", lugre.ModelError, [{"effect": "current_limit", "current": 2.0},
+                                   {"effect": "current_limit", "current": 3.0}], False),
+]
+
+
+@pytest.mark.parametrize("path,cls,effects,rotary", BAD_DRIVE_EFFECTS,
+                         ids=[f"{p}-{k}" for k, (p, *_) in enumerate(BAD_DRIVE_EFFECTS)])
+def test_drive_effect_validation_same_errors(path, cls, effects, rotary):
+    """The core's check (the model's) and the twin's parser (reference/parsed.py) give
+    the same error, naming the same path."""
+    d = lugre.Model.paper().to_dict()
+    d["effects"] = effects
+    if rotary:
+        d["axis"] = dict(ROTARY_AXIS)
+    with pytest.raises(cls) as core_err:
+        lugre.Model.from_dict(d)
+    assert core_err.value.path == path if cls is lugre.ModelError else (
+        core_err.value.name == path)
+    t = [0.0, 1e-4, 2e-4]
+    for backend in BACKENDS:
+        with pytest.raises(cls) as e:
+            backend.simulate(unchecked(d), t, [0.0, 0.0, 0.0])
+        assert str(e.value) == str(core_err.value)
+
+
+def test_drive_effects_save_round_trip(tmp_path):
+    d = drive_model("rotary:gravity+resonance+load").to_dict()
+    d["effects"].append({**RIPPLE, "note": "kept"})
+    m = lugre.Model.from_dict(d)
+    lugre.save_model(m, tmp_path / "m.json")
+    back = lugre.load_model(tmp_path / "m.json")
+    assert back == m and back.effects[-1]["note"] == "kept"
+
+
 # ---- fit_static: variable projection + IRLS + Nelder-Mead ---------------------------------
 
 

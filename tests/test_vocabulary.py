@@ -7,7 +7,16 @@ import lugre
 import pytest
 from lugre import _core
 from lugre.diagnosis.candidates import candidates
-from lugre.vocabulary import EFFECTS, NAMES, ONE_OF_A_KIND, held_kinds, is_timing, kind
+from lugre.vocabulary import (
+    EFFECTS,
+    FORCE_RIPPLE,
+    GRAVITY,
+    NAMES,
+    ONE_OF_A_KIND,
+    held_kinds,
+    is_timing,
+    kind,
+)
 
 
 def test_the_registry_names_what_the_core_simulates():
@@ -41,9 +50,16 @@ def test_every_parameter_has_a_unit_and_every_effect_an_experiment():
 
 def test_the_parser_accepts_every_name_and_rejects_others():
     base = lugre.Model.paper().to_dict()
+    rotary = {**base, "axis": {"kind": "rotary", "inertia": 0.5, "torque_constant": 2.0}}
     for n in NAMES:
         eff = {"effect": n, **{p.name: _value(n, p.name) for p in EFFECTS[n].parameters}}
-        lugre.Model.from_dict({**base, "effects": [eff]})
+        lugre.Model.from_dict({**rotary, "effects": [eff]})
+        if n == GRAVITY:  # a linear axis's weight is an offset
+            with pytest.raises(lugre.ModelError, match="rotary axes only") as e:
+                lugre.Model.from_dict({**base, "effects": [eff]})
+            assert e.value.path == "effects[0].effect" and "offset" in str(e.value)
+        else:
+            lugre.Model.from_dict({**base, "effects": [eff]})
     with pytest.raises(lugre.ModelError, match="unknown effect"):
         lugre.Model.from_dict({**base, "effects": [{"effect": "backlash"}]})
 
@@ -57,4 +73,6 @@ def _value(effect: str, name: str) -> object:
         return [0.0, 0.1]
     if name == "scale":
         return [1.0, 1.1]
+    if effect == FORCE_RIPPLE and name == "amplitude":  # a share, below 1
+        return 0.5
     return 0.5 if name in ("load_fraction", "gain") else 1.0

@@ -225,6 +225,7 @@ fn load_coupling<'py>(
         let opts = CouplingOptions {
             scale: sc,
             extra: ex,
+            level: None,
             z0,
             substeps,
         };

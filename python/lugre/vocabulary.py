@@ -11,10 +11,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["ALIASES", "COGGING", "CURRENT_LAG", "DEADBAND", "DELAY", "DRAG", "DRIFT", "EFFECTS",
-           "MASS", "MASS_EFFECTS", "NAMES", "OFFSET", "ONE_OF_A_KIND", "POSITION_FRICTION", "RESONANCE",
-           "SPRING", "STRIBECK_SHAPE", "TIMING", "TIMING_FORMS", "Effect", "Parameter",
-           "canonical", "held_kinds", "is_timing", "kind"]
+__all__ = ["ALIASES", "COGGING", "CURRENT_LAG", "CURRENT_LIMIT", "DEADBAND", "DELAY", "DRAG",
+           "DRIFT", "EFFECTS", "FORCE_RIPPLE", "GRAVITY", "LOAD_FRICTION", "MASS", "MASS_EFFECTS",
+           "NAMES", "OFFSET", "ONE_OF_A_KIND", "POSITION_FRICTION", "RESONANCE", "SPRING",
+           "STRIBECK_SHAPE", "TIMING", "TIMING_FORMS", "Effect", "Parameter", "canonical",
+           "held_kinds", "is_timing", "kind"]
 
 
 #: The effect names, each spelled here once; everything else takes them from here.
@@ -30,6 +31,10 @@ RESONANCE = "resonance"
 DEADBAND = "deadband"
 DRAG = "drag"
 STRIBECK_SHAPE = "stribeck_shape"
+GRAVITY = "gravity"
+LOAD_FRICTION = "load_friction"
+FORCE_RIPPLE = "force_ripple"
+CURRENT_LIMIT = "current_limit"
 
 
 @dataclass(frozen=True)
@@ -131,6 +136,20 @@ EFFECTS: dict[str, Effect] = {e.name: e for e in (
     Effect(STRIBECK_SHAPE, (Parameter("exponent", ""),),
            "slow feeds at speeds from a tenth to ten times the Stribeck velocity", "v",
            one_of_a_kind=True),
+    # (rotary axes only: the torque [N m] is written in a linear axis's unit, "N", as
+    # every unit here; lugre.units speaks it as N m on a rotary axis)
+    Effect(GRAVITY, (Parameter("torque", "N"), Parameter("phase", "rad")),
+           "slow constant-speed moves over a whole turn, or the joint's whole swing, in "
+           "both directions", "x", one_of_a_kind=True),
+    Effect(LOAD_FRICTION, (Parameter("coefficient", ""),),
+           "moves in both directions at the same speeds under light and heavy loads (a "
+           "payload, or hard accelerations beside slow feeds)", "v", one_of_a_kind=True),
+    Effect(FORCE_RIPPLE, (Parameter("amplitude", ""), _m("pitch"), Parameter("phase", "rad")),
+           "constant-speed moves over at least three pitches in each direction, at two "
+           "different forces (a payload or an incline: cogging stays, ripple scales)", "x"),
+    Effect(CURRENT_LIMIT, (Parameter("current", "A"),),
+           "fast moves or steps that ask the amplifier for more current than it gives",
+           "t", one_of_a_kind=True),
 )}
 
 #: Every effect name, in the vocabulary's order.

@@ -8,10 +8,11 @@
 //!
 //! `r = filt(F_m') - m*a - filt(F_friction + F_effects)`
 //!
-//! where `F_m'` is the motor force after the model's `delay`, `deadband` and
-//! `current_lag`, `F_friction` the LuGre force with its bristles advanced over each
-//! sample interval with the velocity (and friction scale) at its middle, and `filt` the
-//! zero-phase low-pass applied to the position. With a `resonance` the motor carries
+//! where `F_m'` is the motor force after the model's `delay`, `deadband`,
+//! `current_limit`, `current_lag` and `force_ripple`, `F_friction` the LuGre force with
+//! its bristles advanced over each sample interval with the velocity (and friction
+//! scale, and a `load_friction`'s rise of the levels under `F_m'`) at its middle, and
+//! `filt` the zero-phase low-pass applied to the position. With a `resonance` the motor carries
 //! `(1 - r)*m*a` plus the force its coupling passes to the load, the load simulated
 //! along the measured motion ([`crate::servo::load_coupling`]).
 //!
@@ -30,7 +31,7 @@ pub use spectrum::{position_sums, PositionSums, MAX_FREQUENCIES, RESEED};
 
 use crate::error::{check_finite, check_len, Error, Result};
 use crate::servo::coupling::coupling_forces;
-use crate::servo::effects::drift_factor;
+use crate::servo::effects::{drift_factor, Actuator};
 use crate::servo::fast::{Fast, Power, Shape, Square};
 use crate::servo::{coupling_force, CouplingOptions, Effect, Model};
 
@@ -185,40 +186,73 @@ impl Record {
         s
     }
 
-    /// Unfiltered LuGre force at the samples (position/drift scales and Stribeck
-    /// exponent of the model included).
+    /// The rise `coefficient*|F_m'|` [N] of the friction levels at the samples under a
+    /// `load_friction`, `F_m'` the unfiltered motor force after the actuator
+    /// ([`Record::actuator_force`], else the recorded one); `None` without one.
+    pub fn friction_level(&self, model: &Model) -> Option<Vec<f64>> {
+        let act = Actuator::new(&model.effects);
+        act.load?;
+        let f = self.actuator_force(model);
+        let f = f.as_deref().unwrap_or(&self.fm);
+        Some(f.iter().map(|&y| act.level(y)).collect())
+    }
+
+    /// Unfiltered LuGre force at the samples (position/drift scales, the rise of a
+    /// `load_friction` and the Stribeck exponent of the model included).
     pub fn base_friction(&self, model: &Model) -> Vec<f64> {
         let exponent = exponent_of(model);
         let s = self.friction_scale(model);
+        let level = self.friction_level(model);
         let fr = Fast::new(&model.friction, exponent);
-        match exponent {
-            None => self.lugre_force(&fr, Square, s.as_deref()),
-            Some(e) => self.lugre_force(&fr, Power(e), s.as_deref()),
+        let (s, l) = (s.as_deref(), level.as_deref());
+        match (exponent, l) {
+            (None, None) => self.lugre_force::<_, false>(&fr, Square, s, &[]),
+            (None, Some(l)) => self.lugre_force::<_, true>(&fr, Square, s, l),
+            (Some(e), None) => self.lugre_force::<_, false>(&fr, Power(e), s, &[]),
+            (Some(e), Some(l)) => self.lugre_force::<_, true>(&fr, Power(e), s, l),
         }
     }
 
-    /// The force at each sample `k` at `(z_k, v[k])` with `s[k]`; then `z` advanced
-    /// over the interval with the velocity and scale at its middle.
-    fn lugre_force<S: Shape>(&self, fr: &Fast, shape: S, s: Option<&[f64]>) -> Vec<f64> {
+    /// The force at each sample `k` at `(z_k, v[k])` with `s[k]` (and the levels raised
+    /// by `level[k]` when `LOADED`); then `z` advanced over the interval with the
+    /// velocity, scale and level at its middle.
+    fn lugre_force<S: Shape, const LOADED: bool>(
+        &self,
+        fr: &Fast,
+        shape: S,
+        s: Option<&[f64]>,
+        level: &[f64],
+    ) -> Vec<f64> {
         let n = self.len();
         let v = &self.v[..n];
         let s = s.map(|s| &s[..n]);
+        let level = if LOADED { &level[..n] } else { level };
         let mut out = vec![0.0; n];
         let mut z = 0.0;
         for k in 0..n {
             let sc = s.map_or(1.0, |s| s[k]);
-            out[k] = fr.eval(shape, z, v[k], sc).1;
+            out[k] = if LOADED {
+                fr.eval_level(shape, z, v[k], sc, level[k]).1
+            } else {
+                fr.eval(shape, z, v[k], sc).1
+            };
             if k + 1 < n {
                 let u = 0.5 * (v[k] + v[k + 1]);
                 let su = s.map_or(1.0, |s| 0.5 * (s[k] + s[k + 1]));
-                z = fr.advance_z(z, u, fr.g(shape, u, su), self.dt);
+                let g = if LOADED {
+                    fr.g_level(shape, u, su, 0.5 * (level[k] + level[k + 1]))
+                } else {
+                    fr.g(shape, u, su)
+                };
+                z = fr.advance_z(z, u, g, self.dt);
             }
         }
         out
     }
 
-    /// Unfiltered sum of the effect forces (cogging, spring, offset, drag) at the
-    /// samples, added effect by effect in the order of the model ([`Effect::add_force`]).
+    /// Unfiltered sum of the effect forces (cogging, spring, offset, drag, gravity) at
+    /// the samples, added effect by effect in the order of the model
+    /// ([`Effect::add_force`]).
     pub fn effect_force(&self, model: &Model) -> Vec<f64> {
         let forces: Vec<&Effect> = model.effects.iter().filter(|e| e.is_force()).collect();
         self.x
@@ -229,28 +263,35 @@ impl Record {
     }
 
     /// Unfiltered force the `resonance` coupling passes to the load, the load simulated
-    /// along the drive motion with its friction, the friction scales and the effect
-    /// forces on it.
+    /// along the drive motion with its friction, the friction scales, the rise of the
+    /// levels of a `load_friction` and the effect forces on it.
     pub fn coupling_force(&self, model: &Model) -> Result<Vec<f64>> {
-        let (scale, extra) = self.load_forces(model);
-        let opts = self.coupling_options(scale.as_deref(), &extra);
-        coupling_force(model, &self.x_drive, &self.v, self.dt, &opts)
+        let load = self.load_forces(model);
+        coupling_force(
+            model,
+            &self.x_drive,
+            &self.v,
+            self.dt,
+            &self.coupling_options(&load),
+        )
     }
 
-    /// The friction scale and the effect forces acting on the load of a `resonance`.
-    fn load_forces(&self, model: &Model) -> (Option<Vec<f64>>, Vec<f64>) {
-        (self.friction_scale(model), self.effect_force(model))
+    /// The friction scale, the effect forces and the rise of the friction levels on
+    /// the load of a `resonance`.
+    fn load_forces(&self, model: &Model) -> LoadForces {
+        LoadForces {
+            scale: self.friction_scale(model),
+            extra: self.effect_force(model),
+            level: self.friction_level(model),
+        }
     }
 
     /// The options of the load simulation of [`Record::coupling_force`].
-    fn coupling_options<'a>(
-        &self,
-        scale: Option<&'a [f64]>,
-        extra: &'a [f64],
-    ) -> CouplingOptions<'a> {
+    fn coupling_options<'a>(&self, load: &'a LoadForces) -> CouplingOptions<'a> {
         CouplingOptions {
-            scale,
-            extra: Some(extra),
+            scale: load.scale.as_deref(),
+            extra: Some(&load.extra),
+            level: load.level.as_deref(),
             z0: 0.0,
             substeps: COUPLING_SUBSTEPS,
         }
@@ -302,24 +343,37 @@ impl Record {
         self.a.iter().zip(f).map(|(a, f)| ma * a + f).collect()
     }
 
-    /// Filtered motor force after the model's `delay`, `deadband` and `current_lag`
-    /// (in this order).
+    /// Filtered motor force after the model's actuator ([`Record::actuator_force`]);
+    /// the prepared `filt(F_m)` when the model changes nothing.
     pub fn motor_force(&self, model: &Model) -> Vec<f64> {
+        match self.actuator_force(model) {
+            None => self.fm_f.clone(),
+            Some(f) => self.filt(&f),
+        }
+    }
+
+    /// Unfiltered motor force after the model's `delay` (`numpy.interp` at `t - d`),
+    /// `deadband` (`sign(f)*max(|f| - K_F*c, 0)`), `current_limit` (clipped to
+    /// `+-K_F*current`), `current_lag` ([`lag_foh`]) and `force_ripple` (times
+    /// `1 + sum A*sin(2*pi*x/pitch + phase)` at the low-passed position), in this order;
+    /// `None` when the model has none of them.
+    pub fn actuator_force(&self, model: &Model) -> Option<Vec<f64>> {
+        let kf = model.axis.force_constant;
+        let act = Actuator::new(&model.effects);
         let mut delay = None;
-        let mut band = None;
         let mut lag = None;
         for e in &model.effects {
             match e {
                 Effect::Delay { seconds } if *seconds > 0.0 => delay = Some(*seconds),
-                Effect::Deadband { current } if *current > 0.0 => {
-                    band = Some(current * model.axis.force_constant)
-                }
                 Effect::CurrentLag { bandwidth_hz } => lag = Some(*bandwidth_hz),
                 _ => {}
             }
         }
-        if delay.is_none() && band.is_none() && lag.is_none() {
-            return self.fm_f.clone();
+        let band = act.deadband.filter(|&c| c > 0.0).map(|c| c * kf);
+        let limit = act.limit.map(|c| c * kf);
+        let none = [delay, band, limit, lag].iter().all(Option::is_none);
+        if none && act.ripple.is_empty() {
+            return None;
         }
         let mut f = self.fm.clone();
         if let Some(d) = delay {
@@ -327,14 +381,20 @@ impl Record {
             interp_into(&ts, &self.t, &self.fm, &mut f);
         }
         if let Some(b) = band {
-            for y in f.iter_mut() {
-                *y = deadband(*y, b);
-            }
+            f.iter_mut().for_each(|y| *y = deadband(*y, b));
+        }
+        if let Some(l) = limit {
+            f.iter_mut().for_each(|y| *y = y.clamp(-l, l));
         }
         if let Some(bw) = lag {
             lag_foh(&mut f, bw, self.dt);
         }
-        self.filt(&f)
+        if !act.ripple.is_empty() {
+            for (y, &x) in f.iter_mut().zip(&self.x) {
+                *y = act.ripple(*y, x);
+            }
+        }
+        Some(f)
     }
 
     /// Force residual `filt(F_m') - m*a - filt(F_friction + F_effects)` [N].
@@ -357,14 +417,14 @@ impl Record {
         let mut out: Vec<Option<Result<Vec<f64>>>> = (0..models.len()).map(|_| None).collect();
         // the models with a resonance: their load simulations side by side, then (in
         // the cache) the low-passes of those forces side by side
-        let loads: Vec<(Option<Vec<f64>>, Vec<f64>)> = coupled
+        let loads: Vec<LoadForces> = coupled
             .par_iter()
             .map(|&j| self.load_forces(&models[j]))
             .collect();
         let jobs: Vec<(&Model, CouplingOptions)> = coupled
             .iter()
             .zip(&loads)
-            .map(|(&j, (s, e))| (&models[j], self.coupling_options(s.as_deref(), e)))
+            .map(|(&j, load)| (&models[j], self.coupling_options(load)))
             .collect();
         let done = coupling_forces(&jobs, &self.x_drive, &self.v, self.dt, |idx, forces| {
             let ms: Vec<&Model> = idx.iter().map(|&i| &models[coupled[i]]).collect();
@@ -426,6 +486,16 @@ impl Record {
             })
             .collect()
     }
+}
+
+/// What acts on the load of a `resonance` besides the coupling, per sample.
+struct LoadForces {
+    /// The friction scale (`None`: 1).
+    scale: Option<Vec<f64>>,
+    /// The effect forces [N].
+    extra: Vec<f64>,
+    /// The rise of the friction levels (`None`: 0).
+    level: Option<Vec<f64>>,
 }
 
 /// The model's Stribeck exponent when it is not 2.
@@ -507,9 +577,25 @@ mod tests {
 
     #[test]
     fn sensitivities_match_differences() {
-        let rec = record(3000);
         let mut m = Model::paper();
         m.friction.sigma0 = 2e3; // slow bristles: presliding visible at 1 kHz
+        sensitivities_of(&m);
+        // the levels raised under the motor force, after a dead band and a ripple
+        m.effects = vec![
+            Effect::LoadFriction { coefficient: 0.2 },
+            Effect::ForceRipple {
+                amplitude: 0.1,
+                pitch: 0.013,
+                phase: 0.0,
+            },
+            Effect::Deadband { current: 0.3 },
+        ];
+        sensitivities_of(&m);
+    }
+
+    /// The columns of [`Record::base_sensitivities`] against forward differences.
+    fn sensitivities_of(m: &Model) {
+        let rec = record(3000);
         let names = [
             "positive.fc",
             "positive.fs",
@@ -523,8 +609,8 @@ mod tests {
             "sigma1",
         ];
         let params: Vec<BaseParam> = names.iter().map(|n| BaseParam::parse(n).unwrap()).collect();
-        let sens = rec.base_sensitivities(&m, &params);
-        let f0 = rec.base_friction(&m);
+        let sens = rec.base_sensitivities(m, &params);
+        let f0 = rec.base_friction(m);
         for (a, b) in sens.force.iter().zip(&f0) {
             assert_eq!(a, b);
         }
@@ -589,6 +675,60 @@ mod tests {
         for (m, r) in models.iter().zip(&all) {
             assert_eq!(&rec.residual(m).unwrap(), r);
         }
+    }
+
+    #[test]
+    fn the_actuator_in_its_order_and_the_levels_it_raises() {
+        let rec = record(600);
+        let kf = Model::paper().axis.force_constant;
+        let mut m = Model::paper();
+        assert_eq!(rec.actuator_force(&m), None);
+        assert_eq!(rec.friction_level(&m), None);
+        assert_eq!(rec.motor_force(&m), rec.fm_f);
+        let (a, pitch, phase) = (0.08, 0.011, -0.4);
+        m.effects = vec![
+            Effect::ForceRipple {
+                amplitude: a,
+                pitch,
+                phase,
+            },
+            Effect::CurrentLimit { current: 1.8 },
+            Effect::Deadband { current: 0.2 },
+        ];
+        let f = rec.actuator_force(&m).unwrap();
+        let w = 2.0 * core::f64::consts::PI / pitch;
+        let mut clipped = 0;
+        for (k, (&fm, &x)) in rec.fm.iter().zip(&rec.x).enumerate() {
+            // the dead band on the force, then the clip, then the ripple at x
+            let d = deadband(fm, 0.2 * kf);
+            let c = d.clamp(-1.8 * kf, 1.8 * kf);
+            clipped += usize::from(c != d);
+            let want = c * (1.0 + a * (w * x + phase).sin());
+            assert_eq!(f[k].to_bits(), want.to_bits(), "sample {k}");
+        }
+        assert!(clipped > 0 && clipped < rec.len());
+        assert_eq!(rec.motor_force(&m), f);
+        assert_eq!(rec.friction_level(&m), None);
+        m.effects.push(Effect::LoadFriction { coefficient: 0.1 });
+        let level = rec.friction_level(&m).unwrap();
+        assert!(level.iter().zip(&f).all(|(l, f)| *l == 0.1 * f.abs()));
+        // without an actuator the recorded force raises the levels
+        m.effects = vec![Effect::LoadFriction { coefficient: 0.1 }];
+        let level = rec.friction_level(&m).unwrap();
+        assert!(level.iter().zip(&rec.fm).all(|(l, f)| *l == 0.1 * f.abs()));
+        // steady sliding: the LuGre force is the Stribeck force with fc and fs raised
+        let lifted = rec.base_friction(&m);
+        let mut up = Model::paper();
+        let k = 300; // (v = 0.04*cos(0.6): sliding forwards for a while)
+        let rise = level[k];
+        up.friction.positive.fc += rise;
+        up.friction.positive.fs += rise;
+        let want = up.friction.stribeck(rec.v[k]);
+        assert!(
+            (lifted[k] - want).abs() < 1e-3 * want,
+            "{} {want}",
+            lifted[k]
+        );
     }
 
     #[test]

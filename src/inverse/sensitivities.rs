@@ -4,7 +4,8 @@
 
 use super::{exponent_of, Record};
 use crate::error::{Error, Result};
-use crate::friction::{LugreParams, StaticSet};
+use crate::friction::StaticSet;
+use crate::servo::effects::g_loaded;
 use crate::servo::Model;
 
 /// A base friction parameter, by its path in the model file.
@@ -90,15 +91,6 @@ fn stribeck_e(set: &StaticSet<f64>, v: f64, exponent: f64) -> (f64, f64) {
     ((-p).exp(), p)
 }
 
-/// `g(v)` of the set acting at `v` (exponent 2 as [`StaticSet::g`]).
-#[inline(always)]
-fn g_of(p: &LugreParams<f64>, v: f64, exponent: Option<f64>) -> f64 {
-    match exponent {
-        Some(e) => p.set(v).g_shaped(v, e),
-        None => p.set(v).g(v),
-    }
-}
-
 /// The value at the middle of each sample interval (the last sample kept).
 fn midpoints(a: &[f64]) -> Vec<f64> {
     let n = a.len();
@@ -125,7 +117,9 @@ pub struct Sensitivities {
 
 impl Record {
     /// The LuGre force of [`Record::base_friction`] and its filtered derivatives with
-    /// respect to `params`, propagated exactly through the bristle update.
+    /// respect to `params`, propagated exactly through the bristle update. (A
+    /// `load_friction` raises both levels by the same amount, which depends on none of
+    /// the parameters: the derivatives keep their form.)
     pub fn base_sensitivities(&self, model: &Model, params: &[BaseParam]) -> Sensitivities {
         let n = self.len();
         let q = params.len();
@@ -136,6 +130,8 @@ impl Record {
         let s1 = p.sigma1;
         let s = self.friction_scale(model);
         let sh = s.as_deref().map(midpoints);
+        let lev = self.friction_level(model);
+        let lh = lev.as_deref().map(midpoints);
         let vh = midpoints(&self.v);
         let mut force = vec![0.0; n];
         let mut cols = vec![vec![0.0; n]; q];
@@ -147,7 +143,7 @@ impl Record {
             let sc = s.as_ref().map_or(1.0, |s| s[k]);
             let pos = v >= 0.0;
             let set = p.set(v);
-            let g = sc * g_of(p, v, exponent);
+            let g = sc * g_loaded(set, v, lev.as_ref().map_or(0.0, |l| l[k]), exponent);
             let w = v - s0 * v.abs() * z / g;
             force[k] = s0 * z + s1 * w + set.sigma2 * v;
             // (one exponential for every parameter of the set; unused without fc, fs, vs)
@@ -171,7 +167,7 @@ impl Record {
             let su = sh.as_ref().map_or(1.0, |s| s[k]);
             let upos = u >= 0.0;
             let uset = p.set(u);
-            let gh = su * g_of(p, u, exponent);
+            let gh = su * g_loaded(uset, u, lh.as_ref().map_or(0.0, |l| l[k]), exponent);
             let sign = if u > 0.0 { 1.0 } else { -1.0 };
             let zss = sign * gh / s0;
             let e = (-(s0 * u.abs() * self.dt / gh)).exp();

@@ -42,9 +42,12 @@ pub struct CouplingOptions<'a> {
     /// One positive factor per sample multiplying `g(v)` (position- or time-dependent
     /// friction levels); `None` for 1.
     pub scale: Option<&'a [f64]>,
-    /// Further force on the load per sample [N] (cogging, springs, offsets, drag
-    /// evaluated by the caller); `None` for 0.
+    /// Further force on the load per sample [N] (cogging, springs, offsets, drag,
+    /// gravity evaluated by the caller); `None` for 0.
     pub extra: Option<&'a [f64]>,
+    /// Rise of both friction levels of both directions per sample [N], `>= 0` (a
+    /// `load_friction`'s `coefficient*|F_m|`, evaluated by the caller); `None` for 0.
+    pub level: Option<&'a [f64]>,
     /// Initial bristle deflection [m].
     pub z0: f64,
     /// Multiplier (>= 1) of the automatic number of substeps per sample interval.
@@ -56,6 +59,7 @@ impl Default for CouplingOptions<'_> {
         Self {
             scale: None,
             extra: None,
+            level: None,
             z0: 0.0,
             substeps: 1,
         }
@@ -180,6 +184,16 @@ fn check_inputs(
     if let Some(ex) = opts.extra {
         check_len("extra", ex, x.len(), "x")?;
         check_finite("extra", ex)?;
+    }
+    if let Some(lv) = opts.level {
+        check_len("level", lv, x.len(), "x")?;
+        check_finite("level", lv)?;
+        if let Some(k) = lv.iter().position(|&l| l < 0.0) {
+            return Err(Error::input(
+                "level",
+                format!("element {k} is {}: give levels of zero or more", lv[k]),
+            ));
+        }
     }
     let n = cp.auto_substeps(dt) * opts.substeps as f64;
     if n > MAX_SUBSTEPS {
@@ -379,11 +393,12 @@ fn run_width<S: Shape, const L: usize>(
         }
         let s: [f64; L] = core::array::from_fn(|l| op[l].scale.map_or(1.0, |a| a[i]));
         let fe: [f64; L] = core::array::from_fn(|l| op[l].extra.map_or(0.0, |a| a[i]));
+        let lv: [Option<f64>; L] = core::array::from_fn(|l| op[l].level.map(|a| a[i]));
         let (dx, dv) = (x[i + 1] - x0, v[i + 1] - v0);
         // the substeps of every lane, side by side
         let mut sub = |xm: f64, vm: f64| {
             for l in 0..L {
-                ld[l].step(shape, xm, vm, s[l], fe[l], h, hh);
+                ld[l].step(shape, xm, vm, s[l], lv[l], fe[l], h, hh);
             }
         };
         sub(x0, v0);
@@ -459,17 +474,30 @@ impl Load {
         self.k * (xm - self.xl) + self.c * (vm - self.v_start(hh))
     }
 
-    /// One substep of length `h` (`hh = h/2`) with the motor at `(xm, vm)`: the
-    /// velocities at its start and middle predicted from the last acceleration (the
-    /// bristles' update then does not wait for this substep's acceleration), then
-    /// leapfrog.
+    /// One substep of length `h` (`hh = h/2`) with the motor at `(xm, vm)`, friction
+    /// scale `s` and level rise `lv`: the velocities at its start and middle predicted
+    /// from the last acceleration (the bristles' update then does not wait for this
+    /// substep's acceleration), then leapfrog.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn step<S: Shape>(&mut self, shape: S, xm: f64, vm: f64, s: f64, fe: f64, h: f64, hh: f64) {
+    fn step<S: Shape>(
+        &mut self,
+        shape: S,
+        xm: f64,
+        vm: f64,
+        s: f64,
+        lv: Option<f64>,
+        fe: f64,
+        h: f64,
+        hh: f64,
+    ) {
         let vt = self.v_start(hh);
         let vz = self.vl + h * self.al;
         let fs = self.k * (xm - self.xl) + self.c * (vm - vt);
-        let (g, ff) = self.fr.eval(shape, self.z, vt, s);
+        let (g, ff) = match lv {
+            None => self.fr.eval(shape, self.z, vt, s),
+            Some(l) => self.fr.eval_level(shape, self.z, vt, s, l),
+        };
         self.al = (fs - ff - fe) / self.ml;
         self.z = self.fr.advance_z(self.z, vz, g, h);
         self.vl += self.al * h;
@@ -540,11 +568,12 @@ fn run_shaped<S: Shape>(
             break;
         }
         let s = opts.scale.map_or(1.0, |a| a[i]);
+        let lv = opts.level.map(|a| a[i]);
         let fe = opts.extra.map_or(0.0, |a| a[i]);
         let (dx, dv) = (x[i + 1] - x0, v[i + 1] - v0);
-        ld.step(shape, x0, v0, s, fe, h, hh);
+        ld.step(shape, x0, v0, s, lv, fe, h, hh);
         for &f in &fracs {
-            ld.step(shape, x0 + dx * f, v0 + dv * f, s, fe, h, hh);
+            ld.step(shape, x0 + dx * f, v0 + dv * f, s, lv, fe, h, hh);
         }
         if !ld.is_finite() {
             return Err(diverged(i));
@@ -667,9 +696,11 @@ mod tests {
             substeps: 4,
             ..Default::default()
         };
+        let level: Vec<f64> = (0..n).map(|k| 2.0 * (k as f64 * dt).cos().abs()).collect();
         let shaped = CouplingOptions {
             scale: Some(&scale),
             extra: Some(&extra),
+            level: Some(&level),
             z0: 1e-5,
             substeps: 2,
         };
@@ -746,5 +777,33 @@ mod tests {
             r.force[n - 1]
         );
         assert!((r.v[n - 1] - vm).abs() < 1e-9);
+        // both levels raised by 4.5 N (a load_friction): 4.5 N more
+        let level = vec![4.5; n];
+        let o = CouplingOptions {
+            level: Some(&level),
+            ..o
+        };
+        let r = load_coupling(&m, &x, &v, dt, &o).unwrap();
+        let want = m.friction.stribeck(vm) + 3.0 + 4.5;
+        assert!((r.force[n - 1] - want).abs() < 1e-6 * want);
+        let bad = [f64::NAN; 3];
+        let o = CouplingOptions {
+            level: Some(&bad[..2]),
+            ..CouplingOptions::default()
+        };
+        let e = load_coupling(&m, &x[..3], &v[..3], dt, &o).unwrap_err();
+        assert!(
+            matches!(&e, Error::Input { name, .. } if name == "level"),
+            "{e}"
+        );
+        let o = CouplingOptions {
+            level: Some(&[0.0, -1.0, 0.0]),
+            ..o
+        };
+        let e = load_coupling(&m, &x[..3], &v[..3], dt, &o).unwrap_err();
+        assert!(
+            matches!(&e, Error::Input { name, .. } if name == "level"),
+            "{e}"
+        );
     }
 }

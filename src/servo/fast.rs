@@ -2,13 +2,16 @@
 //! and of the inverse dynamics (`crate::inverse`): the operations of
 //! [`LugreParams::eval`], [`LugreParams::eval_shaped`] and [`LugreParams::advance_z`]
 //! in the same order, with the Stribeck exponential skipped where it cannot change
-//! `g(v)`. The results are bit-identical to those of [`LugreParams`].
+//! `g(v)`. The results are bit-identical to those of [`LugreParams`], and with the
+//! levels raised by a `load_friction` to those of `effects::eval_loaded`.
 //!
 //! `g(v) = fc + (fs - fc)*exp(-p)`, `p = |v/vs|^n`: when `(fs - fc)*exp(-p)` is below
 //! `fc*2^-54` (less than half a unit in the last place of `fc`), the sum rounds to `fc`
 //! exactly. That holds for `p > ln((fs - fc)/fc) + 60*ln(2)` (6 bits of margin for
 //! the rounding of `exp`, the product and the threshold itself): at the paper's values,
-//! speeds above about 6.7 `vs`, most of the samples of a moving axis.
+//! speeds above about 6.7 `vs`, most of the samples of a moving axis. With both levels
+//! raised by `level >= 0`, `(fc + level) + (fs - fc)*exp(-p)` rounds to `fc + level` under
+//! the same threshold (a larger sum has a larger unit in the last place).
 
 use crate::friction::{LugreParams, StaticSet};
 
@@ -47,6 +50,10 @@ impl Curve {
 pub(crate) trait Shape: Copy + Send + Sync {
     /// `g(v)` of the set `c` (unscaled), as [`StaticSet::g`] or [`StaticSet::g_shaped`].
     fn g(self, c: &Curve, v: f64) -> f64;
+
+    /// `g(v)` with both levels raised by `level >= 0` [N], as `effects::g_loaded`:
+    /// `(fc + level) + (fs - fc)*exp(-p)`.
+    fn g_level(self, c: &Curve, v: f64, level: f64) -> f64;
 }
 
 /// Exponent 2 ([`StaticSet::g`]).
@@ -64,6 +71,17 @@ impl Shape for Square {
             c.fc + c.dfs * (-p).exp()
         }
     }
+
+    #[inline(always)]
+    fn g_level(self, c: &Curve, v: f64, level: f64) -> f64 {
+        let r = v / c.vs;
+        let p = r * r;
+        if p > c.skip {
+            c.fc + level
+        } else {
+            (c.fc + level) + c.dfs * (-p).exp()
+        }
+    }
 }
 
 /// Another exponent ([`StaticSet::g_shaped`]).
@@ -78,6 +96,16 @@ impl Shape for Power {
             c.fc
         } else {
             c.fc + c.dfs * (-(r.powf(self.0))).exp()
+        }
+    }
+
+    #[inline(always)]
+    fn g_level(self, c: &Curve, v: f64, level: f64) -> f64 {
+        let r = (v / c.vs).abs();
+        if r > c.skip {
+            c.fc + level
+        } else {
+            (c.fc + level) + c.dfs * (-(r.powf(self.0))).exp()
         }
     }
 }
@@ -117,6 +145,29 @@ impl Fast {
         (g, self.force(c, z, v, g))
     }
 
+    /// `scale*g(v)` with the levels raised by `level` [N] (a `load_friction`).
+    #[inline(always)]
+    pub(crate) fn g_level<S: Shape>(&self, shape: S, v: f64, scale: f64, level: f64) -> f64 {
+        let c = if v >= 0.0 { &self.pos } else { &self.neg };
+        scale * shape.g_level(c, v, level)
+    }
+
+    /// `(g, F)` of `effects::eval_loaded`: [`Fast::eval`] with the levels raised by
+    /// `level` [N].
+    #[inline(always)]
+    pub(crate) fn eval_level<S: Shape>(
+        &self,
+        shape: S,
+        z: f64,
+        v: f64,
+        scale: f64,
+        level: f64,
+    ) -> (f64, f64) {
+        let c = if v >= 0.0 { &self.pos } else { &self.neg };
+        let g = scale * shape.g_level(c, v, level);
+        (g, self.force(c, z, v, g))
+    }
+
     #[inline(always)]
     fn force(&self, c: &Curve, z: f64, v: f64, g: f64) -> f64 {
         let zdot = v - self.s0 * v.abs() * z / g;
@@ -138,6 +189,7 @@ impl Fast {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::servo::effects::eval_loaded;
 
     #[test]
     fn bit_identical_to_the_plain_evaluation() {
@@ -172,6 +224,18 @@ mod tests {
                             p.advance_z(z, v, want.0, h).to_bits(),
                             f.advance_z(z, v, got.0, h).to_bits()
                         );
+                        for level in [0.0, 1e-9, 0.37, 250.0] {
+                            let want = eval_loaded(&p, z, v, sc, level, ex);
+                            let got = match ex {
+                                None => f.eval_level(Square, z, v, sc, level),
+                                Some(e) => f.eval_level(Power(e), z, v, sc, level),
+                            };
+                            assert_eq!(want.0.to_bits(), got.0.to_bits(), "g at {v} {level}");
+                            assert_eq!(want.1.to_bits(), got.1.to_bits(), "F at {v} {level}");
+                        }
+                        // (a level of zero is the plain evaluation)
+                        let plain = eval_loaded(&p, z, v, sc, 0.0, ex);
+                        assert_eq!(plain.1.to_bits(), want.1.to_bits());
                     }
                 }
             }

@@ -139,6 +139,37 @@ pub enum Effect {
         /// Exponent of the Stribeck curve [-].
         exponent: f64,
     },
+    /// `F = torque*sin(x + phase)` on the load of a rotary axis (a weight on a joint; on a
+    /// linear axis gravity is an `Offset`).
+    Gravity {
+        /// Largest torque of the weight [N m].
+        torque: f64,
+        /// Angle [rad]: the torque is largest at `x = pi/2 - phase`.
+        phase: f64,
+    },
+    /// fc and fs of both directions raised by `coefficient*|F_m|`, `F_m` the motor force
+    /// acting (after the actuator's dead band, limit, lag and ripple).
+    LoadFriction {
+        /// Friction per newton of motor force [-].
+        coefficient: f64,
+    },
+    /// Motor force `K_F*i*(1 + amplitude*sin(2*pi*x/pitch + phase))` (force-constant
+    /// ripple), at the motor's position.
+    ForceRipple {
+        /// Relative amplitude [-], `|amplitude| < 1`.
+        amplitude: f64,
+        /// Pitch [m].
+        pitch: f64,
+        /// Phase [rad].
+        phase: f64,
+    },
+    /// Motor force `K_F*clip(i, -current, current)`: the amplifier saturates (the
+    /// recorded current is the command). Not the axis's `current_limit`, which clips the
+    /// controller's command itself.
+    CurrentLimit {
+        /// Largest current that produces force [A].
+        current: f64,
+    },
 }
 
 /// Feed-forward law.
@@ -427,34 +458,7 @@ impl Model {
                     .collect::<Result<Vec<_>>>()?
             }
         };
-        let n_delay = effects
-            .iter()
-            .filter(|e| matches!(e, Effect::Delay { .. }))
-            .count();
-        let n_lag = effects
-            .iter()
-            .filter(|e| matches!(e, Effect::CurrentLag { .. }))
-            .count();
-        if n_delay > 1 || n_lag > 1 {
-            return Err(Error::model(
-                "effects",
-                "holds more than one delay or current_lag: merge them into one",
-            ));
-        }
-        let n_res = effects
-            .iter()
-            .filter(|e| matches!(e, Effect::Resonance { .. }))
-            .count();
-        let n_shape = effects
-            .iter()
-            .filter(|e| matches!(e, Effect::StribeckShape { .. }))
-            .count();
-        if n_res > 1 || n_shape > 1 {
-            return Err(Error::model(
-                "effects",
-                "holds more than one resonance or stribeck_shape: keep one of each",
-            ));
-        }
+        check_effects(&effects, axis.kind)?;
         let dm: f64 = effects
             .iter()
             .map(|e| {
@@ -512,6 +516,52 @@ impl Model {
                 })
                 .sum::<f64>()
     }
+}
+
+/// The rules on a model's effects as a whole (each effect is checked on its own by
+/// `parse_effect`): `gravity` only on a rotary axis, then at most one each of `delay`,
+/// `current_lag`, `resonance`, `stribeck_shape`, `gravity`, `load_friction` and
+/// `current_limit`.
+fn check_effects(effects: &[Effect], kind: AxisKind) -> Result<()> {
+    if kind == AxisKind::Linear {
+        if let Some(k) = effects
+            .iter()
+            .position(|e| matches!(e, Effect::Gravity { .. }))
+        {
+            return Err(Error::model(
+                &format!("effects[{k}].effect"),
+                "is gravity, which acts on rotary axes only: on a linear axis a weight is \
+                 a constant force, give {\"effect\": \"offset\", \"force\": F} instead",
+            ));
+        }
+    }
+    let count = |pick: fn(&Effect) -> bool| effects.iter().filter(|e| pick(e)).count();
+    if count(|e| matches!(e, Effect::Delay { .. })) > 1
+        || count(|e| matches!(e, Effect::CurrentLag { .. })) > 1
+    {
+        return Err(Error::model(
+            "effects",
+            "holds more than one delay or current_lag: merge them into one",
+        ));
+    }
+    if count(|e| matches!(e, Effect::Resonance { .. })) > 1
+        || count(|e| matches!(e, Effect::StribeckShape { .. })) > 1
+    {
+        return Err(Error::model(
+            "effects",
+            "holds more than one resonance or stribeck_shape: keep one of each",
+        ));
+    }
+    if count(|e| matches!(e, Effect::Gravity { .. })) > 1
+        || count(|e| matches!(e, Effect::LoadFriction { .. })) > 1
+        || count(|e| matches!(e, Effect::CurrentLimit { .. })) > 1
+    {
+        return Err(Error::model(
+            "effects",
+            "holds more than one gravity, load_friction or current_limit: keep one of each",
+        ));
+    }
+    Ok(())
 }
 
 fn parse_controller(c: &Value, friction: &LugreParams<f64>) -> Result<Controller> {
@@ -719,5 +769,55 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.to_string().contains("more than one"), "{e}");
+    }
+
+    #[test]
+    fn gravity_acts_on_rotary_axes_only_and_some_effects_come_once() {
+        let gravity = r#"{"effect": "gravity", "torque": 2.0, "phase": 0.1}"#;
+        let e =
+            with_effects(&format!(r#"{{"effect": "offset", "force": 1}}, {gravity}"#)).unwrap_err();
+        assert!(
+            matches!(&e, Error::Model { path, .. } if path == "effects[1].effect"),
+            "{e}"
+        );
+        let msg = e.to_string();
+        assert!(
+            msg.contains("rotary axes only") && msg.contains("offset"),
+            "{msg}"
+        );
+        let rotary = PAPER.replace(
+            r#""axis": {"mass": 25.0, "force_constant": 25.0}"#,
+            r#""axis": {"kind": "rotary", "inertia": 0.5, "torque_constant": 2.0}"#,
+        );
+        let on = |effects: &str| {
+            Model::from_json(
+                &rotary.replace(r#""effects": []"#, &format!(r#""effects": [{effects}]"#)),
+            )
+        };
+        let m = on(gravity).unwrap();
+        assert_eq!(
+            m.effects,
+            vec![Effect::Gravity {
+                torque: 2.0,
+                phase: 0.1
+            }]
+        );
+        let lf = r#"{"effect": "load_friction", "coefficient": 0.1}"#;
+        let cl = r#"{"effect": "current_limit", "current": 3}"#;
+        let rp = r#"{"effect": "force_ripple", "amplitude": 0.05, "pitch": 0.7}"#;
+        // several ripples add up; the others come once
+        assert!(on(&format!("{gravity}, {lf}, {cl}, {rp}, {rp}")).is_ok());
+        for twice in [
+            format!("{gravity}, {gravity}"),
+            format!("{lf}, {rp}, {lf}"),
+            format!("{cl}, {cl}"),
+        ] {
+            let e = on(&twice).unwrap_err();
+            assert!(
+                matches!(&e, Error::Model { path, .. } if path == "effects"),
+                "{e}"
+            );
+            assert!(e.to_string().contains("more than one gravity"), "{e}");
+        }
     }
 }

@@ -11,7 +11,7 @@ import numpy as np
 from .._args import as_array as _array
 from .._args import check_substeps_type as _check_substeps_type
 from .._result import CouplingResult
-from ..exceptions import DataError, ModelError, ParameterError, _fmt_f64
+from ..exceptions import DataError, InputError, ModelError, ParameterError, _fmt_f64
 from ..model import ModelLike
 from ..vocabulary import RESONANCE
 from .checks import (
@@ -23,7 +23,7 @@ from .checks import (
     _finite_option_any,
     _parsed,
 )
-from .friction import _advance_z, _eval, _eval_shaped
+from .friction import _advance_z, _eval, _eval_loaded, _eval_shaped
 from .parsed import _Friction
 from .plant import _TwoMass
 
@@ -98,12 +98,23 @@ def load_coupling(
     DataError
         The load's state turned non-finite.
     """
+    return _load_coupling(x, v, dt, model, scale=scale, extra=extra, z0=z0,
+                          substeps=substeps)
+
+
+def _load_coupling(x: Any, v: Any, dt: float, model: ModelLike, *, scale: Any = None,
+                   extra: Any = None, level: Any = None, z0: float = 0.0,
+                   substeps: int = 1) -> CouplingResult:
+    """:func:`load_coupling` with ``level``: the rise of both friction levels per sample
+    [N] (a ``load_friction``'s ``coefficient*|F_m|``, ``CouplingOptions::level``), which
+    the inverse dynamics gives and the facade does not offer."""
     # the facade's conversions, then the core's checks in the core's order
     parsed = _parsed(model)
     xa = _array("x", x).tolist()
     va = _array("v", v).tolist()
     sc = None if scale is None else _array("scale", scale).tolist()
     ex = None if extra is None else _array("extra", extra).tolist()
+    lv = None if level is None else _array("level", level).tolist()
     dtf = _finite_option_any("dt", dt)
     _check_substeps_type(substeps)
     res = next((e.params for e in parsed.effects if e.kind == RESONANCE), None)
@@ -135,6 +146,13 @@ def load_coupling(
     if ex is not None:
         _check_len("extra", ex, n, "x")
         _check_finite("extra", ex)
+    if lv is not None:
+        _check_len("level", lv, n, "x")
+        _check_finite("level", lv)
+        for k, u in enumerate(lv):
+            if u < 0.0:
+                raise InputError.at(
+                    "level", f"element {k} is {_fmt_f64(u)}: give levels of zero or more")
     kc, c, ml = tm.k, tm.c, tm.ml
     w = math.sqrt((kc + p.sigma0) / ml)
     d = (c + p.sigma1 + max(p.positive.sigma2, p.negative.sigma2)) / ml
@@ -148,13 +166,15 @@ def load_coupling(
             f"stiffness (at most {_fmt_f64(_MAX_COUPLING_SUBSTEPS)}): give samples at a "
             "shorter interval",
         )
-    return _drive_load(xa, va, sc, ex, dtf, int(nsub_f), z, tm, p, exponent)
+    return _drive_load(xa, va, sc, ex, lv, dtf, int(nsub_f), z, tm, p, exponent)
 
 
 def _drive_load(xa: list[float], va: list[float], sc: list[float] | None,
-                ex: list[float] | None, dtf: float, nsub: int, z: float, tm: _TwoMass,
-                p: _Friction, exponent: float | None) -> CouplingResult:
-    """The load driven along the checked motor motion, ``nsub`` substeps per interval."""
+                ex: list[float] | None, lv: list[float] | None, dtf: float, nsub: int,
+                z: float, tm: _TwoMass, p: _Friction, exponent: float | None
+                ) -> CouplingResult:
+    """The load driven along the checked motor motion, ``nsub`` substeps per interval
+    (the friction levels raised by ``lv[i]`` over interval ``i`` when given)."""
     n = len(xa)
     kc, c, ml = tm.k, tm.c, tm.ml
     out_f = [0.0] * n
@@ -181,6 +201,7 @@ def _drive_load(xa: list[float], va: list[float], sc: list[float] | None,
             break
         s = 1.0 if sc is None else sc[i]
         fe = 0.0 if ex is None else ex[i]
+        lvi = None if lv is None else lv[i]
         dx, dv = xa[i + 1] - x0, va[i + 1] - v0
         for j in range(nsub):
             if j == 0:
@@ -191,7 +212,9 @@ def _drive_load(xa: list[float], va: list[float], sc: list[float] | None,
             vt = vl + hh * al
             vz = vl + h * al
             fs = kc * (xm - xl) + c * (vm - vt)
-            if exponent is None:
+            if lvi is not None:
+                g, ff, _ = _eval_loaded(p, z, vt, s, lvi, exponent)
+            elif exponent is None:
                 g, ff, _ = _eval(p, z, vt, s)
             else:
                 g, ff, _ = _eval_shaped(p, z, vt, s, exponent)

@@ -32,6 +32,18 @@ def _g_shaped(s: _StaticSet, v: float, exponent: float) -> float:
     return s.fc + (s.fs - s.fc) * _exp(-(r**exponent))
 
 
+def _g_loaded(s: _StaticSet, v: float, level: float, exponent: float | None) -> float:
+    """``g(v)`` with both levels raised by ``level`` (``effects::g_loaded``):
+    ``(fc + level) + (fs - fc)*exp(-p)``, ``p`` as :func:`_g` (``exponent`` None) or
+    :func:`_g_shaped` computes it."""
+    if exponent is None:
+        r = v / s.vs
+        e = _exp(-(r * r))
+    else:
+        e = _exp(-(abs(v / s.vs) ** exponent))
+    return (s.fc + level) + (s.fs - s.fc) * e
+
+
 def _stribeck1(p: _Friction, v: float) -> float:
     """Steady-state friction ``sign(v)*g(v) + sigma2*v``, zero at ``v == 0``."""
     if v == 0.0:
@@ -55,6 +67,18 @@ def _eval_shaped(
     """As :func:`_eval` with the generalised curve (``LugreParams::eval_shaped``)."""
     s = p.positive if v >= 0.0 else p.negative
     g = scale * _g_shaped(s, v, exponent)
+    zdot = v - p.sigma0 * abs(v) * z / g
+    f = p.sigma0 * z + p.sigma1 * zdot + s.sigma2 * v
+    return g, f, zdot
+
+
+def _eval_loaded(
+    p: _Friction, z: float, v: float, scale: float, level: float, exponent: float | None
+) -> tuple[float, float, float]:
+    """As :func:`_eval` (or :func:`_eval_shaped`) with the levels raised by ``level``
+    (``effects::eval_loaded``, a ``load_friction``)."""
+    s = p.positive if v >= 0.0 else p.negative
+    g = scale * _g_loaded(s, v, level, exponent)
     zdot = v - p.sigma0 * abs(v) * z / g
     f = p.sigma0 * z + p.sigma1 * zdot + s.sigma2 * v
     return g, f, zdot

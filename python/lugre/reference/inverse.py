@@ -3,8 +3,9 @@
 The same steps as the core, in the same order (``docs/DESIGN.md``, "Inverse
 dynamics"): the zero-phase low-pass by second-order sections with odd extension, the
 friction scales, the bristles advanced with the mid-interval velocity, the effect forces,
-the load behind a ``resonance``, the motor force after delay, dead-band and current lag,
-and the exact sensitivities of the LuGre force to its parameters. Exported as
+the load behind a ``resonance``, the motor force after delay, dead-band, current limit,
+current lag and force ripple (and the friction levels it raises under a
+``load_friction``), and the exact sensitivities of the LuGre force to its parameters. Exported as
 ``lugre.reference.InverseRecord``; the diagnosis runs on either.
 """
 
@@ -22,10 +23,14 @@ from ..model import ModelLike, _as_model
 from ..vocabulary import (
     COGGING,
     CURRENT_LAG,
+    CURRENT_LIMIT,
     DEADBAND,
     DELAY,
     DRAG,
     DRIFT,
+    FORCE_RIPPLE,
+    GRAVITY,
+    LOAD_FRICTION,
     OFFSET,
     POSITION_FRICTION,
     RESONANCE,
@@ -265,17 +270,25 @@ class InverseRecord:
         return None
 
     @staticmethod
-    def _g(fr: dict[str, Any], v: float, exponent: float | None) -> float:
+    def _g(fr: dict[str, Any], v: float, exponent: float | None,
+           level: float | None = None) -> float:
+        """``g(v)``, both levels raised by ``level`` when given (a ``load_friction``:
+        ``(fc + level) + (fs - fc)*exp(-p)``)."""
         s = fr["positive"] if v >= 0.0 else fr["negative"]
         r = v / s["vs"]
-        if exponent is None:
-            return s["fc"] + (s["fs"] - s["fc"]) * math.exp(-(r * r))
-        return s["fc"] + (s["fs"] - s["fc"]) * math.exp(-(abs(r) ** exponent))
+        e = math.exp(-(r * r)) if exponent is None else math.exp(-(abs(r) ** exponent))
+        if level is None:
+            return s["fc"] + (s["fs"] - s["fc"]) * e
+        return (s["fc"] + level) + (s["fs"] - s["fc"]) * e
 
-    def _bristles(self, m: Any, exponent: float | None) -> tuple[list[float], Any]:
+    def _bristles(self, m: Any, exponent: float | None
+                  ) -> tuple[list[float], Any, list[float] | None]:
+        """The bristle state at the samples, the friction scale and the levels' rise."""
         s = self.friction_scale(m)
+        lev = self._friction_level(m)
         vh = _midpoints(self.v).tolist()
         sh = None if s is None else _midpoints(s).tolist()
+        lh = None if lev is None else _midpoints(lev).tolist()
         fr = m.friction
         s0 = float(fr["sigma0"])
         dt = self.dt
@@ -285,29 +298,31 @@ class InverseRecord:
             zs.append(z)
             if u == 0.0:
                 continue
-            g = (1.0 if sh is None else sh[k]) * self._g(fr, u, exponent)
+            g = ((1.0 if sh is None else sh[k])
+                 * self._g(fr, u, exponent, None if lh is None else lh[k]))
             sign = 1.0 if u > 0.0 else -1.0
             zss = sign * g / s0
             z = zss + (z - zss) * math.exp(-(s0 * abs(u) * dt / g))
-        return zs, s
+        return zs, s, None if lev is None else lev.tolist()
 
     def base_friction(self, model: ModelLike) -> np.ndarray:
         """Unfiltered LuGre force at the samples."""
         m = _as_model(model)
         ex = self._exponent(m)
-        z, s = self._bristles(m, ex)
+        z, s, lev = self._bristles(m, ex)
         fr = m.friction
         s0, s1 = float(fr["sigma0"]), float(fr["sigma1"])
         out = np.empty(len(self))
         for k, v in enumerate(self.v.tolist()):
-            g = (1.0 if s is None else float(s[k])) * self._g(fr, v, ex)
+            g = ((1.0 if s is None else float(s[k]))
+                 * self._g(fr, v, ex, None if lev is None else lev[k]))
             s2 = fr["positive"]["sigma2"] if v >= 0.0 else fr["negative"]["sigma2"]
             zdot = v - s0 * abs(v) * z[k] / g
             out[k] = s0 * z[k] + s1 * zdot + s2 * v
         return out
 
     def effect_force(self, model: ModelLike) -> np.ndarray:
-        """Unfiltered sum of the effect forces (cogging, spring, offset, drag)."""
+        """Unfiltered sum of the effect forces (cogging, spring, offset, drag, gravity)."""
         m = _as_model(model)
         out = np.zeros(len(self))
         x, v = self.x, self.v
@@ -324,15 +339,18 @@ class InverseRecord:
                 out += e["force"]
             elif k == DRAG:
                 out += e["coefficient"] * np.abs(v) * v
+            elif k == GRAVITY:
+                out += e["torque"] * np.sin(x + e.get("phase", 0.0))
         return out
 
     def coupling_force(self, model: ModelLike) -> np.ndarray:
         """Unfiltered force the ``resonance`` coupling passes to the load."""
-        from .coupling import load_coupling
+        from .coupling import _load_coupling
 
         m = _as_model(model)
-        return load_coupling(self.x_drive, self.v, self.dt, m, scale=self.friction_scale(m),
-                             extra=self.effect_force(m), substeps=COUPLING_SUBSTEPS).force
+        return _load_coupling(self.x_drive, self.v, self.dt, m, scale=self.friction_scale(m),
+                              extra=self.effect_force(m), level=self._friction_level(m),
+                              substeps=COUPLING_SUBSTEPS).force
 
     def model_force(self, model: ModelLike) -> np.ndarray:
         """Filtered force the model needs besides the motor."""
@@ -346,24 +364,51 @@ class InverseRecord:
         return (1.0 - r) * mass * self.a + self.filt(self.coupling_force(m))
 
     def motor_force(self, model: ModelLike) -> np.ndarray:
-        """Filtered motor force after the ``delay``, ``deadband`` and ``current_lag``."""
-        m = _as_model(model)
-        delay = band = lag = None
+        """Filtered motor force after the actuator (:meth:`_actuator_force`)."""
+        f = self._actuator_force(_as_model(model))
+        return self.fm_f.copy() if f is None else self.filt(f)
+
+    def _friction_level(self, m: Any) -> np.ndarray | None:
+        """The rise ``coefficient*|F_m'|`` of the friction levels under a
+        ``load_friction`` (``Record::friction_level``), or None."""
+        c = None
+        for e in m.effects:
+            if e["effect"] == LOAD_FRICTION:
+                c = float(e["coefficient"])
+        if c is None:
+            return None
+        f = self._actuator_force(m)
+        return c * np.abs(self.fm if f is None else f)
+
+    def _actuator_force(self, m: Any) -> np.ndarray | None:
+        """Unfiltered motor force after the ``delay``, ``deadband``, ``current_limit``,
+        ``current_lag`` and ``force_ripple``, in this order (``Record::actuator_force``);
+        None without them."""
+        delay = db = limit = lag = None
+        ripple = []
         for e in m.effects:
             k = e["effect"]
             if k == DELAY and e["seconds"] > 0:
                 delay = float(e["seconds"])
-            elif k == DEADBAND and e["current"] > 0:
-                band = float(e["current"]) * m.force_constant
+            elif k == DEADBAND:
+                db = float(e["current"])
+            elif k == CURRENT_LIMIT:
+                limit = float(e["current"]) * m.force_constant
             elif k == CURRENT_LAG:
                 lag = float(e["bandwidth"])
-        if delay is None and band is None and lag is None:
-            return self.fm_f.copy()
+            elif k == FORCE_RIPPLE:
+                ripple.append((float(e["amplitude"]), 2.0 * math.pi / float(e["pitch"]),
+                               float(e.get("phase", 0.0))))
+        band = db * m.force_constant if db is not None and db > 0 else None
+        if delay is None and band is None and limit is None and lag is None and not ripple:
+            return None
         f = self.fm.copy()
         if delay is not None:
             f = _interp(self.t - delay, self.t, self.fm)
         if band is not None:
             f = np.sign(f) * np.maximum(np.abs(f) - band, 0.0)
+        if limit is not None:
+            f = np.clip(f, -limit, limit)
         if lag is not None:
             a = 2.0 * math.pi * lag * self.dt
             c = math.exp(-a)
@@ -376,7 +421,12 @@ class InverseRecord:
                 state = b2 * x + c * out
                 y[k] = out
             f = np.array(y)
-        return self.filt(f)
+        if ripple:
+            r = np.ones(f.size)
+            for a, w, ph in ripple:
+                r = r + a * np.sin(w * self.x + ph)
+            f = f * r
+        return f
 
     def residual(self, model: ModelLike) -> np.ndarray:
         """Force residual ``filt(F_m') - m*a - filt(F_friction + F_effects)`` [N]."""
@@ -416,6 +466,9 @@ class InverseRecord:
         s = self.friction_scale(m)
         sl = None if s is None else s.tolist()
         sh = None if s is None else _midpoints(s).tolist()
+        lev = self._friction_level(m)  # (the levels' rise depends on no parameter)
+        ll = None if lev is None else lev.tolist()
+        lh = None if lev is None else _midpoints(lev).tolist()
         vl = self.v.tolist()
         vh = _midpoints(self.v).tolist()
         n, q = len(vl), len(params)
@@ -444,7 +497,7 @@ class InverseRecord:
         for k in range(n):
             v = vl[k]
             sc = 1.0 if sl is None else sl[k]
-            g = sc * self._g(fr, v, ex)
+            g = sc * self._g(fr, v, ex, None if ll is None else ll[k])
             s2 = fr["positive"]["sigma2"] if v >= 0.0 else fr["negative"]["sigma2"]
             w = v - s0 * abs(v) * z / g
             force[k] = s0 * z + s1 * w + s2 * v
@@ -461,7 +514,7 @@ class InverseRecord:
             if u == 0.0:
                 continue
             su = 1.0 if sh is None else sh[k]
-            gh = su * self._g(fr, u, ex)
+            gh = su * self._g(fr, u, ex, None if lh is None else lh[k])
             sign = 1.0 if u > 0.0 else -1.0
             zss = sign * gh / s0
             e = math.exp(-(s0 * abs(u) * dt / gh))

@@ -15,10 +15,14 @@ from ..exceptions import ModelError, ParameterError
 from ..vocabulary import (
     COGGING,
     CURRENT_LAG,
+    CURRENT_LIMIT,
     DEADBAND,
     DELAY,
     DRAG,
     DRIFT,
+    FORCE_RIPPLE,
+    GRAVITY,
+    LOAD_FRICTION,
     MASS,
     NAMES,
     OFFSET,
@@ -251,6 +255,7 @@ def _parse_friction(f: Any, path: str) -> _Friction:
 
 
 def _parse_effect(e: Any, path: str) -> _Effect:
+    """One entry of ``effects`` (``parse_effect`` in effects.rs, checks in its order)."""
     e = _obj(e, path)
     kind = _get(e, "effect", path)
     if not isinstance(kind, str):
@@ -262,25 +267,16 @@ def _parse_effect(e: Any, path: str) -> _Effect:
     def p(k: str) -> str:
         return _join(path, k)
 
+    def phase() -> float:
+        ph = _opt_num(e, "phase", path)
+        return 0.0 if ph is None else ph
+
     if kind == COGGING:
-        harmonics: list[tuple[float, float]] = []
-        h = e.get("harmonics")
-        if h is not None:
-            hp = p("harmonics")
-            if not isinstance(h, (list, tuple)):
-                raise ModelError.at(hp, "must be a list of [amplitude, phase] pairs")
-            for k, pair in enumerate(h):
-                q = _num_list(pair, f"{hp}[{k}]")
-                if len(q) != 2:
-                    raise ModelError.at(f"{hp}[{k}]", "must be [amplitude, phase]")
-                harmonics.append((q[0], q[1]))
+        harmonics = _parse_harmonics(e, path)
         amplitude = n("amplitude")
         pitch = _positive(n("pitch"), p("pitch"))
-        phase = _opt_num(e, "phase", path)
-        return _Effect(kind, {
-            "amplitude": amplitude, "pitch": pitch,
-            "phase": 0.0 if phase is None else phase, "harmonics": tuple(harmonics),
-        })
+        return _Effect(kind, {"amplitude": amplitude, "pitch": pitch, "phase": phase(),
+                              "harmonics": harmonics})
     if kind == SPRING:
         stiffness = n("stiffness")
         x0 = _opt_num(e, "x0", path)
@@ -288,22 +284,7 @@ def _parse_effect(e: Any, path: str) -> _Effect:
     if kind == OFFSET:
         return _Effect(kind, {"force": n("force")})
     if kind == POSITION_FRICTION:
-        positions = _num_list(_get(e, "positions", path), p("positions"))
-        scale = _num_list(_get(e, "scale", path), p("scale"))
-        if not positions or len(positions) != len(scale):
-            raise ModelError.at(
-                p("scale"),
-                f"has {len(scale)} values for {len(positions)} positions: "
-                "give one scale per position",
-            )
-        for k in range(len(positions) - 1):
-            if positions[k + 1] <= positions[k]:
-                raise ModelError.at(
-                    f"{p('positions')}[{k + 1}]", "positions must be strictly increasing"
-                )
-        for k, s in enumerate(scale):
-            _positive(s, f"{p('scale')}[{k}]")
-        return _Effect(kind, {"positions": tuple(positions), "scale": tuple(scale)})
+        return _parse_position_friction(e, path)
     if kind == DRIFT:
         gain = n("gain")
         if gain >= 1.0:
@@ -335,7 +316,58 @@ def _parse_effect(e: Any, path: str) -> _Effect:
         return _Effect(kind, {"coefficient": _nonneg(n("coefficient"), p("coefficient"))})
     if kind == STRIBECK_SHAPE:
         return _Effect(kind, {"exponent": _positive(n("exponent"), p("exponent"))})
+    if kind == GRAVITY:
+        torque = n("torque")
+        return _Effect(kind, {"torque": torque, "phase": phase()})
+    if kind == LOAD_FRICTION:
+        return _Effect(kind, {"coefficient": _nonneg(n("coefficient"), p("coefficient"))})
+    if kind == FORCE_RIPPLE:
+        a = n("amplitude")
+        if abs(a) >= 1.0:
+            raise ParameterError.invalid(
+                p("amplitude"), a,
+                "must lie strictly between -1 and 1 (a share of the force constant: at 1 the "
+                "motor force would vanish at some positions)",
+            )
+        pitch = _positive(n("pitch"), p("pitch"))
+        return _Effect(kind, {"amplitude": a, "pitch": pitch, "phase": phase()})
+    if kind == CURRENT_LIMIT:
+        return _Effect(kind, {"current": _positive(n("current"), p("current"))})
     raise ModelError.at(p("effect"), f'unknown effect "{kind}": use one of {_EFFECTS}')
+
+
+def _parse_harmonics(e: Mapping[str, Any], path: str) -> tuple[tuple[float, float], ...]:
+    """A cogging's optional ``harmonics``: ``[amplitude, phase]`` of harmonics 2, 3, ..."""
+    harmonics: list[tuple[float, float]] = []
+    h = e.get("harmonics")
+    if h is not None:
+        hp = _join(path, "harmonics")
+        if not isinstance(h, (list, tuple)):
+            raise ModelError.at(hp, "must be a list of [amplitude, phase] pairs")
+        for k, pair in enumerate(h):
+            q = _num_list(pair, f"{hp}[{k}]")
+            if len(q) != 2:
+                raise ModelError.at(f"{hp}[{k}]", "must be [amplitude, phase]")
+            harmonics.append((q[0], q[1]))
+    return tuple(harmonics)
+
+
+def _parse_position_friction(e: Mapping[str, Any], path: str) -> _Effect:
+    """A position_friction: breakpoints strictly increasing, one positive scale each."""
+    pp, ps = _join(path, "positions"), _join(path, "scale")
+    positions = _num_list(_get(e, "positions", path), pp)
+    scale = _num_list(_get(e, "scale", path), ps)
+    if not positions or len(positions) != len(scale):
+        raise ModelError.at(
+            ps, f"has {len(scale)} values for {len(positions)} positions: give one scale per "
+            "position",
+        )
+    for k in range(len(positions) - 1):
+        if positions[k + 1] <= positions[k]:
+            raise ModelError.at(f"{pp}[{k + 1}]", "positions must be strictly increasing")
+    for k, s in enumerate(scale):
+        _positive(s, f"{ps}[{k}]")
+    return _Effect(POSITION_FRICTION, {"positions": tuple(positions), "scale": tuple(scale)})
 
 
 def _parse_current_loop(c: Any) -> _CurrentLoop:
@@ -410,7 +442,7 @@ def _axis_kind(a: Mapping[str, Any]) -> str:
     if k is None:
         return "linear"
     if not isinstance(k, str) or k not in _AXIS_KEYS:
-        raise ModelError(
+        raise ModelError.at(
             "axis.kind",
             'must be "linear" (mass, force_constant) or "rotary" (inertia, torque_constant)')
     return k
@@ -431,36 +463,55 @@ def _parse(v: Mapping[str, Any]) -> _Parsed:
         lim = _positive(lim, "axis.current_limit")
     axis = _Axis(kind, mass, kf, current_loop, lim)
     friction = _parse_friction(_get(v, "friction", ""), "friction")
-    effects = _parse_effects(v, mass)
+    effects = _parse_effects(v, mass, kind)
     c = v.get("controller")
     controller = None if c is None else _parse_controller(c, friction)
     return _Parsed(axis, friction, effects, controller)
 
 
-def _parse_effects(v: Mapping[str, Any], mass: float) -> tuple[_Effect, ...]:
-    """Validate the ``effects`` of a model document whose axis has ``mass`` (the part
-    of :func:`_parse` that depends on them, in its order)."""
+def _parse_effects(v: Mapping[str, Any], mass: float, kind: str) -> tuple[_Effect, ...]:
+    """Validate the ``effects`` of a model document whose axis has ``mass`` and ``kind``
+    (the part of :func:`_parse` that depends on them, in its order)."""
     effects: list[_Effect] = []
     ev = v.get("effects")
     if ev is not None:
         if not isinstance(ev, (list, tuple)):
             raise ModelError.at("effects", "must be a list")
         effects = [_parse_effect(x, f"effects[{k}]") for k, x in enumerate(ev)]
-    n_delay = sum(e.kind == DELAY for e in effects)
-    n_lag = sum(e.kind == CURRENT_LAG for e in effects)
-    if n_delay > 1 or n_lag > 1:
-        raise ModelError.at(
-            "effects", "holds more than one delay or current_lag: merge them into one"
-        )
-    n_res = sum(e.kind == RESONANCE for e in effects)
-    n_shape = sum(e.kind == STRIBECK_SHAPE for e in effects)
-    if n_res > 1 or n_shape > 1:
-        raise ModelError.at(
-            "effects", "holds more than one resonance or stribeck_shape: keep one of each"
-        )
+    _check_effects(effects, kind)
     dm = sum(e.params["delta"] for e in effects if e.kind == MASS)
     if mass + dm <= 0.0:
         raise ParameterError.invalid(
             "effects.mass.delta", float(dm), "makes the total mass zero or negative"
         )
     return tuple(effects)
+
+
+def _check_effects(effects: list[_Effect], kind: str) -> None:
+    """The rules on the effects as a whole (``check_effects`` in model.rs): gravity only
+    on a rotary axis, then at most one each of the one-of-a-kind effects."""
+    if kind == "linear":
+        for k, e in enumerate(effects):
+            if e.kind == GRAVITY:
+                raise ModelError.at(
+                    f"effects[{k}].effect",
+                    "is gravity, which acts on rotary axes only: on a linear axis a weight "
+                    'is a constant force, give {"effect": "offset", "force": F} instead',
+                )
+
+    def count(name: str) -> int:
+        return sum(e.kind == name for e in effects)
+
+    if count(DELAY) > 1 or count(CURRENT_LAG) > 1:
+        raise ModelError.at(
+            "effects", "holds more than one delay or current_lag: merge them into one"
+        )
+    if count(RESONANCE) > 1 or count(STRIBECK_SHAPE) > 1:
+        raise ModelError.at(
+            "effects", "holds more than one resonance or stribeck_shape: keep one of each"
+        )
+    if count(GRAVITY) > 1 or count(LOAD_FRICTION) > 1 or count(CURRENT_LIMIT) > 1:
+        raise ModelError.at(
+            "effects",
+            "holds more than one gravity, load_friction or current_limit: keep one of each",
+        )

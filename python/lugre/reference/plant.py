@@ -10,10 +10,14 @@ from bisect import bisect_right
 from ..vocabulary import (
     COGGING,
     CURRENT_LAG,
+    CURRENT_LIMIT,
     DEADBAND,
     DELAY,
     DRAG,
     DRIFT,
+    FORCE_RIPPLE,
+    GRAVITY,
+    LOAD_FRICTION,
     OFFSET,
     POSITION_FRICTION,
     RESONANCE,
@@ -21,7 +25,7 @@ from ..vocabulary import (
     STRIBECK_SHAPE,
 )
 from .checks import _ceil_f
-from .friction import _advance_z, _eval, _eval_shaped
+from .friction import _advance_z, _eval, _eval_loaded, _eval_shaped
 from .parsed import _CurrentLoop, _Parsed
 
 __all__: list[str] = []
@@ -87,6 +91,9 @@ class _Physics:
         self.shape: float | None = None
         self.drag = 0.0
         self.deadband: float | None = None
+        self.limit: float | None = None
+        self.ripple: list[tuple[float, float, float]] = []
+        self.load_coef: float | None = None  # load_friction
         self.res: _TwoMass | None = None
         for e in m.effects:
             q = e.params
@@ -95,6 +102,14 @@ class _Physics:
                 self.cogging.append((q["amplitude"], w, q["phase"]))
                 for k, (a, ph) in enumerate(q["harmonics"]):
                     self.cogging.append((a, w * (k + 2.0), ph))
+            elif e.kind == GRAVITY:  # one term of wavenumber 1: torque*sin(x + phase)
+                self.cogging.append((q["torque"], 1.0, q["phase"]))
+            elif e.kind == CURRENT_LIMIT:
+                self.limit = q["current"]
+            elif e.kind == FORCE_RIPPLE:
+                self.ripple.append((q["amplitude"], 2.0 * _PI / q["pitch"], q["phase"]))
+            elif e.kind == LOAD_FRICTION:
+                self.load_coef = q["coefficient"]
             elif e.kind == SPRING:
                 self.lin_a += q["stiffness"]
                 self.lin_b -= q["stiffness"] * q["x0"]
@@ -133,22 +148,35 @@ class _Physics:
         """Position and velocity of the body carrying friction and effects."""
         return (s.xl, s.vl) if self.res is not None else (s.x, s.v)
 
-    def friction(self, z: float, v: float, scale: float) -> tuple[float, float, float]:
-        """``(g, F, zdot)`` of the plant's friction (``stribeck_shape`` applied)."""
+    def friction(self, z: float, v: float, scale: float, fm: float
+                 ) -> tuple[float, float, float]:
+        """``(g, F, zdot)`` of the plant's friction (``stribeck_shape`` applied, the levels
+        raised by a ``load_friction`` under the motor force ``fm``)."""
+        if self.load_coef is not None:
+            return _eval_loaded(self.fr, z, v, scale, self.load_coef * abs(fm), self.shape)
         if self.shape is not None:
             return _eval_shaped(self.fr, z, v, scale, self.shape)
         return _eval(self.fr, z, v, scale)
 
-    def deadband_of(self, i: float) -> float:
-        """The current that produces force (``deadband``)."""
+    def drive_force(self, i: float) -> float:
+        """The motor force before a lag: ``K_F*clip(db(i))`` (``deadband``, then
+        ``current_limit``; ``Actuator::current`` in effects.rs)."""
         c = self.deadband
-        if c is None:
-            return i
-        if i > c:
-            return i - c
-        if i < -c:
-            return i + c
-        return 0.0
+        if c is not None:
+            i = i - c if i > c else (i + c if i < -c else 0.0)
+        lim = self.limit
+        if lim is not None:
+            i = max(min(i, lim), -lim)  # f64::clamp
+        return self.kf * i
+
+    def ripple_of(self, f: float, x: float) -> float:
+        """``f`` times the ``force_ripple`` factor ``1 + sum A*sin(w*x + phase)``."""
+        if not self.ripple:
+            return f
+        r = 1.0
+        for a, w, ph in self.ripple:
+            r += a * math.sin(w * x + ph)
+        return f * r
 
     def effect_force(self, x: float, v: float) -> float:
         f = self.lin_a * x + self.lin_b
@@ -162,11 +190,12 @@ class _Physics:
         self, fm: float, x: float, v: float, z: float, time: float
     ) -> tuple[float, float, float]:
         s = self.scale(x, time)
-        g, f, zdot = self.friction(z, v, s)
+        g, f, zdot = self.friction(z, v, s, fm)
         return (fm - f - self.effect_force(x, v)) / self.mass, g, zdot
 
     def motor(self, s: _State, ic: float, h: float) -> float:
-        """Advance the current (loop) and the lagged force over ``h``; the motor force."""
+        """Advance the current (loop) and the lagged force over ``h``; the motor force
+        (dead band, current limit, lag, then the ripple at the step's start)."""
         cl = self.current_loop
         if cl is None:
             s.ia = ic
@@ -189,18 +218,18 @@ class _Physics:
                 a4, b4 = d(s.ia + hs * a3, s.q + hs * b3)
                 s.ia += hs / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
                 s.q += hs / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4)
-        fm = self.kf * self.deadband_of(s.ia)
-        if self.lag_w is None:
-            return fm
-        s.fl = fm + (s.fl - fm) * _exp(-self.lag_w * h)
-        return s.fl
+        fm = self.drive_force(s.ia)
+        if self.lag_w is not None:
+            s.fl = fm + (s.fl - fm) * _exp(-self.lag_w * h)
+            fm = s.fl
+        return self.ripple_of(fm, s.x)
 
     def step_exact(self, s: _State, ic: float, h: float, time: float) -> None:
         fm = self.motor(s, ic, h)
         r = self.res
         if r is not None:
             # two bodies: semi-implicit Euler for both, exact bristle update on the load
-            g, f, _ = self.friction(s.z, s.vl, self.scale(s.xl, time))
+            g, f, _ = self.friction(s.z, s.vl, self.scale(s.xl, time), fm)
             fc = r.k * (s.x - s.xl) + r.c * (s.v - s.vl)
             am = (fm - fc) / r.mm
             al = (fc - f - self.effect_force(s.xl, s.vl)) / r.ml
@@ -221,7 +250,7 @@ class _Physics:
 
         def d(x: float, v: float, xl: float, vl: float, z: float,
               tm: float) -> tuple[float, float, float, float, float]:
-            _, f, zdot = self.friction(z, vl, self.scale(xl, tm))
+            _, f, zdot = self.friction(z, vl, self.scale(xl, tm), fm)
             fc = r.k * (x - xl) + r.c * (v - vl)
             return v, (fm - fc) / r.mm, vl, (fc - f - self.effect_force(xl, vl)) / r.ml, zdot
 
@@ -239,12 +268,13 @@ class _Physics:
         s.vl += h / 6.0 * (k1[3] + 2.0 * k2[3] + 2.0 * k3[3] + k4[3])
         s.z += h / 6.0 * (k1[4] + 2.0 * k2[4] + 2.0 * k3[4] + k4[4])
 
-    def rk4_pieces(self, z: float, v: float, x: float, h: float, time: float) -> int:
+    def rk4_pieces(self, z: float, v: float, x: float, fm: float, h: float, time: float
+                   ) -> int:
         """Pieces of an RK4 step keeping ``sigma0*|v|*h/g`` under the limit
         (``Physics::rk4_pieces``)."""
         if v == 0.0:
             return 1
-        g, _, _ = self.friction(z, v, self.scale(x, time))
+        g, _, _ = self.friction(z, v, self.scale(x, time), fm)
         q = self.fr.sigma0 * abs(v) * h / g
         if math.isnan(q) or q <= _RK4_BRISTLE_LIMIT:  # (NaN: the divergence check)
             return 1
@@ -255,7 +285,7 @@ class _Physics:
         bristles would make it unstable (``Physics::step_rk4``)."""
         fm = self.motor(s, ic, h_step)
         x, v = (s.xl, s.vl) if self.res is not None else (s.x, s.v)
-        p = self.rk4_pieces(s.z, v, x, h_step, time)
+        p = self.rk4_pieces(s.z, v, x, fm, h_step, time)
         h = h_step / float(p)
         for j in range(p):
             tj = time + float(j) * h

@@ -306,21 +306,22 @@ def _run(m: _Parsed, ta: Any, tl: list[float], kind: str, ref: list[float], inte
             n += 1
             tc = ctrl_time(n)
         while k < n_out and tl[k] <= time + tol:
+            if phys.current_loop is not None:
+                fm = phys.drive_force(s.ia)
+            elif phys.delay is not None:
+                fm = phys.drive_force(_ic_eff_peek(queue, ic_eff, time, tol))
+            else:
+                fm = phys.drive_force(ic_eff)
+            fm = phys.ripple_of(s.fl if phys.lag_w is not None else fm, s.x)
             xl, vl = phys.load(s)
             sc = phys.scale(xl, time)
-            _, f, _ = phys.friction(s.z, vl, sc)
+            _, f, _ = phys.friction(s.z, vl, sc, fm)
             out_x.append(s.x)
             out_v.append(s.v)
             out_z.append(s.z)
             out_i.append(s.ia if phys.current_loop is not None else ic)
             out_f.append(f)
-            if phys.current_loop is not None:
-                fm = phys.kf * phys.deadband_of(s.ia)
-            elif phys.delay is not None:
-                fm = phys.kf * phys.deadband_of(_ic_eff_peek(queue, ic_eff, time, tol))
-            else:
-                fm = phys.kf * phys.deadband_of(ic_eff)
-            out_fm.append(s.fl if phys.lag_w is not None else fm)
+            out_fm.append(fm)
             k += 1
         if k == n_out:
             break

@@ -460,26 +460,28 @@ fn sample<const EXTRAS: bool>(
     time: f64,
     tol: f64,
 ) -> (f64, f64, [f64; 6]) {
-    let (xl, vl) = phys.load(s);
-    let sc = phys.scale(xl, time);
-    let (g, f, _) = phys.friction(s.z, vl, sc);
-    let fm = phys.kf
-        * phys.deadband(if phys.current_loop().is_some() {
-            s.ia
-        } else if phys.delay().is_some() {
-            ic_eff_peek(&cmd.queue, cmd.acting, time, tol)
-        } else {
-            cmd.acting
-        });
+    let fm = phys.drive_force(if phys.current_loop().is_some() {
+        s.ia
+    } else if phys.delay().is_some() {
+        ic_eff_peek(&cmd.queue, cmd.acting, time, tol)
+    } else {
+        cmd.acting
+    });
     let i = if phys.current_loop().is_some() {
         s.ia
     } else {
         cmd.latest
     };
-    let force = match phys.lag_w() {
-        Some(_) => s.fl,
-        None => fm,
-    };
+    let force = phys.ripple(
+        match phys.lag_w() {
+            Some(_) => s.fl,
+            None => fm,
+        },
+        s.x,
+    );
+    let (xl, vl) = phys.load(s);
+    let sc = phys.scale(xl, time);
+    let (g, f, _) = phys.friction(s.z, vl, sc, force);
     (g, f, [s.x, s.v, s.z, i, f, force])
 }
 

@@ -4,7 +4,7 @@
 
 use super::RK4_BRISTLE_LIMIT;
 use crate::friction::LugreParams;
-use crate::servo::effects::{EffectForces, FrictionScale};
+use crate::servo::effects::{eval_loaded, Actuator, EffectForces, FrictionScale};
 use crate::servo::model::{CurrentLoop, Effect, Model};
 use std::f64::consts::PI;
 
@@ -14,15 +14,16 @@ const RK4_MAX_PIECES: f64 = 1e4;
 /// Extra physics, flattened for the inner loop.
 ///
 /// `EXTRAS = false` is the plain axis (no current loop, current lag, delay, cogging,
-/// scaled friction, resonance, dead band, drag or Stribeck shape; springs and offsets
-/// are kept): the simulation loop is compiled once
+/// scaled friction, resonance, dead band, drag, Stribeck shape, gravity, load friction,
+/// force ripple or current limit; springs and offsets are kept): the simulation loop is
+/// compiled once
 /// for it, with every test of the absent physics removed, and once for the general case.
 /// Both run the same code, so their results are identical.
 pub(super) struct Physics<const EXTRAS: bool> {
     mass: f64,
     pub(super) kf: f64,
     fr: LugreParams<f64>,
-    /// Cogging, springs, offsets and drag.
+    /// Cogging, springs, offsets, drag and gravity.
     forces: EffectForces,
     /// `position_friction` and `drift`.
     scales: FrictionScale,
@@ -32,8 +33,8 @@ pub(super) struct Physics<const EXTRAS: bool> {
     t0: f64,
     /// `stribeck_shape` exponent.
     shape: Option<f64>,
-    /// `deadband` half-width [A].
-    deadband: Option<f64>,
+    /// `deadband`, `current_limit`, `force_ripple` and `load_friction`.
+    act: Actuator,
     /// Two-mass `resonance`.
     res: Option<TwoMass>,
 }
@@ -95,7 +96,7 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
             delay: None,
             t0,
             shape: None,
-            deadband: None,
+            act: Actuator::new(&m.effects),
             res: None,
         };
         for e in &m.effects {
@@ -114,10 +115,15 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
                         *load_fraction,
                     ))
                 }
-                Effect::Deadband { current } => p.deadband = Some(*current),
                 Effect::StribeckShape { exponent } => p.shape = Some(*exponent),
-                // forces and friction scales: `forces`, `scales`; mass: `total_mass`
-                Effect::Cogging { .. }
+                // forces and friction scales: `forces`, `scales`; the actuator: `act`;
+                // mass: `total_mass`
+                Effect::Deadband { .. }
+                | Effect::CurrentLimit { .. }
+                | Effect::ForceRipple { .. }
+                | Effect::LoadFriction { .. }
+                | Effect::Gravity { .. }
+                | Effect::Cogging { .. }
                 | Effect::Spring { .. }
                 | Effect::Offset { .. }
                 | Effect::PositionFriction { .. }
@@ -185,10 +191,13 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
     }
 
     /// `(g, F, zdot)` of the plant's friction (generalised Stribeck curve with a
-    /// `stribeck_shape`).
+    /// `stribeck_shape`, levels raised by a `load_friction` under the motor force `fm`).
     #[inline(always)]
-    pub(super) fn friction(&self, z: f64, v: f64, scale: f64) -> (f64, f64, f64) {
+    pub(super) fn friction(&self, z: f64, v: f64, scale: f64, fm: f64) -> (f64, f64, f64) {
         if EXTRAS {
+            if self.act.load.is_some() {
+                return eval_loaded(&self.fr, z, v, scale, self.act.level(fm), self.shape);
+            }
             if let Some(e) = self.shape {
                 return self.fr.eval_shaped(z, v, scale, e);
             }
@@ -196,21 +205,32 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
         self.fr.eval(z, v, scale)
     }
 
-    /// The current that produces force: the `deadband` removes `current` from `|i|`.
+    /// Whether the friction depends on the motor force (a `load_friction`).
     #[inline(always)]
-    pub(super) fn deadband(&self, i: f64) -> f64 {
+    pub(super) fn loaded(&self) -> bool {
+        EXTRAS && self.act.load.is_some()
+    }
+
+    /// The motor force before a `current_lag` of the current `i` the drive is given:
+    /// `K_F*clip(db(i))` (`deadband`, then `current_limit`).
+    #[inline(always)]
+    pub(super) fn drive_force(&self, i: f64) -> f64 {
         if EXTRAS {
-            if let Some(c) = self.deadband {
-                return if i > c {
-                    i - c
-                } else if i < -c {
-                    i + c
-                } else {
-                    0.0
-                };
-            }
+            self.kf * self.act.current(i)
+        } else {
+            self.kf * i
         }
-        i
+    }
+
+    /// The motor force acting on the motor at position `x`: `f` (after any lag) times a
+    /// `force_ripple`'s factor.
+    #[inline(always)]
+    pub(super) fn ripple(&self, f: f64, x: f64) -> f64 {
+        if EXTRAS {
+            self.act.ripple(f, x)
+        } else {
+            f
+        }
     }
 
     #[inline(always)]
@@ -226,7 +246,7 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
     #[inline(always)]
     fn accel(&self, fm: f64, x: f64, v: f64, z: f64, time: f64) -> (f64, f64, f64) {
         let s = self.scale(x, time);
-        let (g, f, zdot) = self.friction(z, v, s);
+        let (g, f, zdot) = self.friction(z, v, s, fm);
         ((fm - f - self.effect_force(x, v)) / self.mass, g, zdot)
     }
 }
@@ -289,7 +309,8 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
         ms
     }
 
-    /// Advance the current (loop) and the lagged force over h; returns the motor force.
+    /// Advance the current (loop) and the lagged force over h; returns the motor force
+    /// (after the actuator: dead band, current limit, lag, ripple at the step's start).
     #[inline(always)]
     fn motor(&self, s: &mut State, ic: f64, ms: &MotorStep) -> f64 {
         match self.current_loop() {
@@ -319,17 +340,19 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
                 }
             }
         }
-        let fm = self.kf * self.deadband(s.ia);
-        match self.lag_w() {
+        let fm = self.drive_force(s.ia);
+        let f = match self.lag_w() {
             None => fm,
             Some(_) => {
                 s.fl = fm + (s.fl - fm) * ms.lag_decay;
                 s.fl
             }
-        }
+        };
+        self.ripple(f, s.x)
     }
 
-    /// `at_state`: `(g, F)` at this state and time when already known (from a sample).
+    /// `at_state`: `(g, F)` at this state and time when already known (from a sample;
+    /// not used with a `load_friction`, whose friction follows this step's motor force).
     #[inline(always)]
     pub(super) fn step_exact(
         &self,
@@ -341,10 +364,11 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
     ) {
         let h = ms.h;
         let fm = self.motor(s, ic, ms);
+        let at_state = if self.loaded() { None } else { at_state };
         if let Some(r) = self.res() {
             // two bodies: semi-implicit Euler for both, exact bristle update on the load
             let (g, f) = at_state.unwrap_or_else(|| {
-                let (g, f, _) = self.friction(s.z, s.vl, self.scale(s.xl, time));
+                let (g, f, _) = self.friction(s.z, s.vl, self.scale(s.xl, time), fm);
                 (g, f)
             });
             let fc = r.k * (s.x - s.xl) + r.c * (s.v - s.vl);
@@ -358,7 +382,7 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
             return;
         }
         let (g, f) = at_state.unwrap_or_else(|| {
-            let (g, f, _) = self.friction(s.z, s.v, self.scale(s.x, time));
+            let (g, f, _) = self.friction(s.z, s.v, self.scale(s.x, time), fm);
             (g, f)
         });
         let a = (fm - f - self.effect_force(s.x, s.v)) / self.mass;
@@ -368,12 +392,12 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
     }
 
     /// Pieces of an RK4 step of length `h` that keep `sigma0*|v|*h/g` of the friction
-    /// at velocity `v` and position `x` under [`RK4_BRISTLE_LIMIT`].
-    fn rk4_pieces(&self, z: f64, v: f64, x: f64, h: f64, time: f64) -> usize {
+    /// at velocity `v` and position `x` (motor force `fm`) under [`RK4_BRISTLE_LIMIT`].
+    fn rk4_pieces(&self, z: f64, v: f64, x: f64, fm: f64, h: f64, time: f64) -> usize {
         if v == 0.0 {
             return 1;
         }
-        let (g, _, _) = self.friction(z, v, self.scale(x, time));
+        let (g, _, _) = self.friction(z, v, self.scale(x, time), fm);
         let q = self.fr.sigma0 * v.abs() * h / g;
         if q.is_nan() || q <= RK4_BRISTLE_LIMIT {
             // (NaN: the divergence check after the step reports it)
@@ -386,7 +410,7 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
     /// RK4 on `(x, v, xl, vl, z)` of the two-mass axis, the motor force held.
     fn step_rk4_two_mass(&self, s: &mut State, fm: f64, r: &TwoMass, h: f64, time: f64) {
         let d = |x: f64, v: f64, xl: f64, vl: f64, z: f64, tm: f64| {
-            let (_, f, zdot) = self.friction(z, vl, self.scale(xl, tm));
+            let (_, f, zdot) = self.friction(z, vl, self.scale(xl, tm), fm);
             let fc = r.k * (x - xl) + r.c * (v - vl);
             (
                 v,
@@ -438,7 +462,7 @@ impl<const EXTRAS: bool> Physics<EXTRAS> {
             Some(_) => (s.xl, s.vl),
             None => (s.x, s.v),
         };
-        let p = self.rk4_pieces(s.z, v, x, ms.h, time);
+        let p = self.rk4_pieces(s.z, v, x, fm, ms.h, time);
         let h = ms.h / p as f64;
         for j in 0..p {
             let tj = time + j as f64 * h;
