@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from . import units as U
 from .model import Model, ModelLike, _as_model
 
 __all__ = ["STATIC_NAMES", "DirectionFit", "DynamicFit", "StaticFit", "SteadyStatePoints"]
@@ -106,7 +107,7 @@ class StaticFit:
         for name, d in (("v > 0", self.positive), ("v < 0", self.negative)):
             lines.append(f"  {name}  (IRLS iterations {d.iterations}, "
                          f"{'converged' if d.converged else 'NOT converged'}, "
-                         f"residual scale {d.scale:.3g} N)")
+                         f"residual scale {d.scale:.3g} {U.si('N')})")
             for k in STATIC_NAMES:
                 lo, hi = d.ci95[k]
                 row = f"    {k:7s} {d.params[k]:12.6g}   95 % CI [{lo:.6g}, {hi:.6g}]"
@@ -170,8 +171,10 @@ class DynamicFit:
 
     def summary(self, truth: dict[str, float] | None = None) -> str:
         """Estimates, intervals, verdicts (and errors against ``truth`` when given)."""
-        lines = [(f"dynamic fit: {self.evaluations} closed-loop simulations, "
-                 f"rms position error {self.rms_error:.3g} m, max {self.max_error:.3g} m")]
+        with U.axis(self.model.kind):
+            u = U.si("m")
+            lines = [(f"dynamic fit: {self.evaluations} closed-loop simulations, "
+                      f"rms position error {self.rms_error:.3g} {u}, max {self.max_error:.3g} {u}")]
         for k in ("sigma0", "sigma1"):
             val = getattr(self, k)
             lo, hi = self.ci95[k]

@@ -209,6 +209,7 @@ _PAPER_PLACEHOLDERS = ("axis.mass", "axis.force_constant", "friction.sigma0",
 
 
 def _cmd_fit_static(args: argparse.Namespace) -> int:
+    from . import units as U
     from .identify import fit_static, steady_state_points
     from .io import is_points_file, read_points
     from .model import Model, load_model, save_model
@@ -217,14 +218,16 @@ def _cmd_fit_static(args: argparse.Namespace) -> int:
                    {"--json": args.json, "--plot": args.plot, "--html": args.html})
     base = load_model(args.model) if args.model else None
     pr = _progress(args)
+    kind = base.kind if base else "linear"
     if is_points_file(args.data):
         v, F = read_points(args.data)
         print(f"{args.data}: {len(v)} steady-state points")
     else:
         kf = args.force_constant or (base.force_constant if base else None)
         with pr.step(f"finding the plateaus of {args.data}"):
-            pts = steady_state_points(_read(args, args.data, kind=base and base.kind), kf,
-                                      chunks=args.chunks)
+            rec = _read(args, args.data, kind=base and base.kind)
+            kind = rec.meta.get("axis_kind", kind)
+            pts = steady_state_points(rec, kf, chunks=args.chunks)
         used = sum(p["settled"] for p in pts.plateaus)
         print(f"{args.data}: {len(pts.plateaus)} plateaus found, {used} settled and used "
               f"({int(pts.used.sum())} samples) -> {len(pts.v)} points")
@@ -233,7 +236,8 @@ def _cmd_fit_static(args: argparse.Namespace) -> int:
         v, F = pts.v, pts.F
     with pr.step("fitting the Stribeck curves"):
         fit = fit_static(v, F, weighting=args.weighting)
-    print(fit.summary())
+    with U.axis(kind):
+        print(fit.summary())
     axis = {}
     if args.mass:
         axis["mass"] = args.mass
@@ -355,6 +359,7 @@ def _cmd_diagnose(args: argparse.Namespace) -> int:
 
 
 def _cmd_evaluate(args: argparse.Namespace) -> int:
+    from . import units as U
     from .diagnosis import evaluate
     from .diagnosis.evaluation import level_shift_text
     from .model import load_model
@@ -362,8 +367,10 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     _check_outputs({"RECORDING": args.recording, "--model": args.model}, {"--json": args.json})
     model = load_model(args.model)
     ev = evaluate(_read(args, args.recording, kind=model.kind), model)
-    print(f"rms force residual {ev['rms_force']:.4g} N, nrmse {100 * ev['nrmse_force']:.3g} %")
-    shift = level_shift_text(ev.get("level_shift"))
+    with U.axis(model.kind):
+        print(f"rms {U.force_words()} residual {ev['rms_force']:.4g} {U.si('N')}, "
+              f"nrmse {100 * ev['nrmse_force']:.3g} %")
+        shift = level_shift_text(ev.get("level_shift"))
     if shift:
         print(f"note: {shift}")
     _write_json(args.json, ev)

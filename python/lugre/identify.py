@@ -18,6 +18,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from . import units as U
 from ._core import fit_dynamic_record, fit_static_points, plateaus
 from ._fits import STATIC_NAMES, DirectionFit, DynamicFit, StaticFit, SteadyStatePoints
 from ._native import _array
@@ -164,8 +165,8 @@ def _check_stick_slip(rec: Recording) -> None:
     resolution = float(steps[steps > 0].min()) if np.any(steps > 0) else 0.0
     if travel == 0.0 or travel < 10 * resolution:
         raise DataError(
-            f"{src}: the axis does not move (position range {travel:.3g} m): the dynamic "
-            "fit needs a closed-loop record with motion that sticks and slips"
+            f"{src}: the axis does not move (position range {travel:.3g} {U.si('m')}): the "
+            "dynamic fit needs a closed-loop record with motion that sticks and slips"
         )
     dt = float(np.median(np.diff(rec.t)))
     w = max(1, round(0.01 / dt))  # 10 ms windows
@@ -174,7 +175,8 @@ def _check_stick_slip(rec: Recording) -> None:
     if n < 3 or not np.any(v <= 0.02 * v.max()):
         raise DataError(
             f"{src}: no stick phase: the speed never falls near zero (slowest 10 ms window "
-            f"{v.min() if n else float('nan'):.3g} m/s against {v.max() if n else 0:.3g} m/s "
+            f"{v.min() if n else float('nan'):.3g} {U.si('m/s')} against "
+            f"{v.max() if n else 0:.3g} {U.si('m/s')} "
             "peak). sigma0 and sigma1 act where the axis sticks: record a slow ramp or "
             "reversals through a soft position loop (stick-slip)"
         )
@@ -408,7 +410,8 @@ def _dynamic_fit(record_fit: Callable[..., Any], recording: Recording | str,
     def run(mm: Model, s0: float | None, s1: float | None, use_grid: bool) -> Any:
         return record_fit(mm, rec, s0, s1, use_grid)
 
-    _check_stick_slip(rec)
+    with U.axis(m.kind):
+        _check_stick_slip(rec)
     r = run(m, sigma0_start, sigma1_start, bool(grid))
     names = ("sigma0", "sigma1")
     est = np.array([r.sigma0, r.sigma1], dtype=float)
@@ -476,10 +479,17 @@ def stribeck_determinacy(recording: Recording, model: ModelLike) -> list[str]:
         determine it; empty when the record covers the slow range.
     """
     m = _as_model(model)
+    with U.axis(m.kind):
+        return _stribeck_notes(recording, m)
+
+
+def _stribeck_notes(recording: Recording, m: Model) -> list[str]:
+    """:func:`stribeck_determinacy` in the units of ``m``'s axis."""
     v = recording.v if recording.v is not None else np.gradient(recording.x, recording.t)
     v = np.asarray(v, float)
     top = float(np.max(np.abs(v))) if v.size else 0.0
     out = []
+    f_u, v_u = U.si("N"), U.si("m/s")
     for d, sign, tag in (("positive", 1.0, "v > 0"), ("negative", -1.0, "v < 0")):
         p = getattr(m, d)
         moving = sign * v > 1e-3 * top
@@ -492,17 +502,19 @@ def stribeck_determinacy(recording: Recording, model: ModelLike) -> list[str]:
         slow = 0.05 * top
         share_slow = float(np.mean(a < slow))
         what = (f"constant-velocity runs in this direction from about {slow / 50:.2g} to "
-                f"{slow:.2g} m/s (lugre fit-static; lugre design-static proposes the speeds)")
+                f"{slow:.2g} {v_u} (lugre fit-static; lugre design-static proposes the "
+                "speeds)")
         if p["fs"] <= 1.01 * p["fc"]:
-            out.append(f"{tag}: the fit found no Stribeck hump (fs = {p['fs']:.4g} N, fc = "
-                       f"{p['fc']:.4g} N), so fs and vs (= {p['vs']:.3g} m/s, any value fits) "
+            out.append(f"{tag}: the fit found no Stribeck hump (fs = {p['fs']:.4g} {f_u}, "
+                       f"fc = {p['fc']:.4g} {f_u}), so fs and vs (= {p['vs']:.3g} {v_u}, any "
+                       "value fits) "
                        f"are NOT determined by this record: {100 * share_slow:.1f} % of its "
-                       f"moving samples are slower than {slow:.2g} m/s (5 % of the top "
+                       f"moving samples are slower than {slow:.2g} {v_u} (5 % of the top "
                        f"speed). Would determine them: {what}")
             continue
         n_hump = int(np.sum(a < 2 * p["vs"]))
         if n_hump < 200 or n_hump < 0.02 * n_mov:
             out.append(f"{tag}: fs and vs rest on {n_hump} samples slower than 2 vs = "
-                       f"{2 * p['vs']:.3g} m/s ({100 * n_hump / n_mov:.1f} % of the moving "
+                       f"{2 * p['vs']:.3g} {v_u} ({100 * n_hump / n_mov:.1f} % of the moving "
                        f"ones): NOT determined by this record. Would determine them: {what}")
     return out

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from . import units as U
 from ._native import simulate
 from .exceptions import DataError
 from .identify import STATIC_NAMES, StaticFit
@@ -160,8 +161,10 @@ def fit_presliding(t: np.ndarray, x: np.ndarray, force: np.ndarray, model: Model
     theta0 = np.log([st.get(k, held[k]) for k in NAMES])
     top = float(np.max(np.abs(force)))
     if top > 0.95 * min(model.positive["fc"], model.negative["fc"]):
-        raise DataError(f"the force reaches {top:.3g} N, near or above fc: the record must "
-                        "stay below break-away (presliding); lower the amplitude")
+        with U.axis(model.kind):
+            raise DataError(U.words(f"the force reaches {top:.3g} {U.si('N')}, near or above "
+                                    "fc: the record must stay below break-away "
+                                    "(presliding); lower the amplitude"))
     xs = float(np.std(x)) or 1.0
     # sigma0 start from the quasi-static compliance x = F/sigma0 over the slow start of
     # the sweep (well below the presliding resonance)
@@ -238,7 +241,8 @@ def fit_presliding(t: np.ndarray, x: np.ndarray, force: np.ndarray, model: Model
         determined[k] = bool(rel[j] <= 0.25)
         if not determined[k]:
             notes.append(f"{k} is NOT determined by this presliding record (+-"
-                         f"{100 * rel[j]:.0f} %): raise the largest force toward 0.9 fc or "
+                         f"{100 * rel[j]:.0f} %): raise the largest "
+                         f"{'torque' if model.is_rotary else 'force'} toward 0.9 fc or "
                          "lengthen the sweep")
     if contrib:
         top_k = max(contrib, key=lambda k: contrib[k])

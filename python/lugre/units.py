@@ -16,13 +16,15 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import math
+import re
 from collections.abc import Iterator
 from typing import Any
 
 from .vocabulary import EFFECTS
 
-__all__ = ["EFFECT_UNITS", "axis", "axis_kind", "axis_units", "base_unit", "display", "fmt", "fmt_range", "force_words",
-           "is_rotary", "mass_words", "position_unit", "si", "where_unit"]
+__all__ = ["EFFECT_UNITS", "axis", "axis_kind", "axis_units", "base_unit", "constant_words",
+           "display", "fmt", "fmt_range", "force_words", "is_rotary", "mass_words", "micro",
+           "position_unit", "si", "where_unit", "words"]
 
 #: A linear axis's SI units and a rotary axis's for the same quantity.
 _ROTARY = {
@@ -74,6 +76,41 @@ def force_words() -> str:
 def mass_words() -> str:
     """``"mass"``, or ``"inertia"`` on a rotary axis."""
     return "inertia" if is_rotary() else "mass"
+
+
+def constant_words() -> str:
+    """``"force constant"``, or ``"torque constant"`` on a rotary axis."""
+    return "torque constant" if is_rotary() else "force constant"
+
+
+#: A linear axis's words and a rotary axis's, for :func:`words`.
+_ROTARY_WORDS = {"force constant": "torque constant", "payloads": "load inertias",
+                 "payload": "load inertia", "forces": "torques", "force": "torque",
+                 "masses": "inertias", "a mass": "an inertia", "mass": "inertia",
+                 "newtons": "newton metres",
+                 "millimetres": "radians", "millimetre": "milliradian",
+                 "micrometres": "microradians", "micrometre": "microradian"}
+_WORDS_RE = re.compile(r"(?<![-\w])(" + "|".join(_ROTARY_WORDS) + r")\b", re.IGNORECASE)
+
+
+def words(text: str) -> str:
+    """``text``, written for a linear axis, in a rotary axis's words when one is spoken
+    ("force" -> "torque", "mass" -> "inertia", "payload" -> "load inertia"); unchanged
+    on a linear axis."""
+    if not is_rotary():
+        return text
+    return _WORDS_RE.sub(_rotary_word, text)
+
+
+def _rotary_word(m: re.Match[str]) -> str:
+    w = _ROTARY_WORDS[m.group(0).lower()]
+    return w[0].upper() + w[1:] if m.group(0)[0].isupper() else w
+
+
+def micro(x: float, digits: int = 3) -> str:
+    """A small position (SI) in micrometres, ``"3.2 um"``, or on a rotary axis in
+    microradians, ``"3.2 µrad"``."""
+    return f"{x * 1e6:.{digits}g} {'µrad' if is_rotary() else 'um'}"
 
 
 def si(unit: str) -> str:

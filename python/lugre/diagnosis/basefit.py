@@ -84,9 +84,11 @@ class BaseFitResult:
     def floor_words(self) -> tuple[str, bool]:
         """How far the fit is from the record's noise floor, in words, and whether that
         is far enough to warn."""
+        with U.axis(self.model.kind):
+            u = U.si("N")
+            head = (f"{U.force_words()} residual {self.rms:.3g} {u} rms against a noise floor "
+                    f"of {self.noise:.3g} {u} ({self.floor_ratio:.2g} times)")
         q = self.floor_ratio
-        head = (f"force residual {self.rms:.3g} N rms against a noise floor of "
-                f"{self.noise:.3g} N ({q:.2g} times)")
         if q <= 1.5:
             return head + ": at the record's noise floor, nothing systematic is left", False
         if q <= 3.0:

@@ -75,15 +75,17 @@ def level_shift_text(ls: dict[str, Any] | None) -> str | None:
     if not ls or not ls["significant"]:
         return None
     p, n = ls["positive"], ls["negative"]
-    figs = (f"{p['shift']:+.3g} N ({100 * p['share_of_fc']:+.1f} % of fc) moving forward, "
-            f"{n['shift']:+.3g} N ({100 * n['share_of_fc']:+.1f} %) moving back")
+    u = U.si("N")
+    figs = (f"{p['shift']:+.3g} {u} ({100 * p['share_of_fc']:+.1f} % of fc) moving forward, "
+            f"{n['shift']:+.3g} {u} ({100 * n['share_of_fc']:+.1f} %) moving back")
     if ls["kind"] == "friction level":
         return (f"the friction on this record differs from the model's by {figs}: friction "
                 "has changed since the model's record (temperature, lubrication, wear); "
                 "compare records taken warm, at the same temperature, or refit the levels "
                 "on this one (lugre diagnose refits them)")
-    return (f"the force on this record differs from the model's by {figs}, opposite ways: "
-            "a constant force (an offset: gravity, a cable) the model does not hold")
+    return U.words(f"the force on this record differs from the model's by {figs}, opposite "
+                   "ways: a constant force (an offset: gravity, a cable) the model does not "
+                   "hold")
 
 
 def evaluate(recording: Any, model: Any, *, cutoff_hz: float | None = None,

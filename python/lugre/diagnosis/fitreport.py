@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from .. import units as U
 from ..model import Model
 from .base import unit
 from .basefit import BaseFitResult
@@ -34,14 +35,16 @@ def _key(name: str) -> str:
 
 
 def fit_unit(name: str) -> str:
-    """SI unit of a fitted parameter (``positive.hump`` is in the unit of ``fs``)."""
-    return unit(name.replace(".hump", ".fs"))
+    """SI unit of a fitted parameter (``positive.hump`` is in the unit of ``fs``), on the
+    axis spoken now (``N m`` for ``N`` on a rotary axis)."""
+    return U.si(unit(name.replace(".hump", ".fs")))
 
 
 def label(name: str) -> str:
-    """``positive.hump`` -> ``fs - fc (v >= 0)``."""
+    """``positive.hump`` -> ``fs - fc (v >= 0)``; ``mass`` is ``inertia`` on a rotary
+    axis."""
     side, _, key = name.rpartition(".")
-    text = "fs - fc" if key == "hump" else key
+    text = "fs - fc" if key == "hump" else U.mass_words() if key == "mass" else key
     return f"{text} ({'v >= 0' if side == 'positive' else 'v < 0'})" if side else text
 
 
@@ -51,7 +54,13 @@ def _num(x: Any) -> float | None:
 
 def identification(fit: BaseFitResult, model: Model, nrmse: float) -> dict[str, Any]:
     """The ``identification`` section of a fitted model file: the fit against the
-    record's noise floor and every fitted parameter with its 95 % interval."""
+    record's noise floor and every fitted parameter with its 95 % interval (units and
+    words of the model's axis)."""
+    with U.axis(model.kind):
+        return _identification(fit, nrmse)
+
+
+def _identification(fit: BaseFitResult, nrmse: float) -> dict[str, Any]:
     params = {}
     for name, p in fit.profiles.items():
         ci = p.get("ci95") or [None, None]
@@ -65,7 +74,13 @@ def identification(fit: BaseFitResult, model: Model, nrmse: float) -> dict[str, 
 
 
 def undetermined_notes(fit: BaseFitResult) -> list[str]:
-    """One sentence per parameter the record does not determine."""
+    """One sentence per parameter the record does not determine (in the words of the
+    fitted model's axis)."""
+    with U.axis(fit.model.kind):
+        return [U.words(n) for n in _undetermined(fit)]
+
+
+def _undetermined(fit: BaseFitResult) -> list[str]:
     out = []
     for name, p in fit.profiles.items():
         if p["determined"]:
