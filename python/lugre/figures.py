@@ -2,7 +2,8 @@
 PNG keeps pages with thousands of points small, at twice the screen resolution).
 
 Quantities carry one unit each across the figures (:mod:`lugre.units`): position in mm,
-speed in mm/s, time in s, force in N. Legends sit above the axes, off the data.
+speed in mm/s, time in s, force in N (rad, rad/s and N m on a rotary axis). Legends sit
+above the axes, off the data.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from . import units as U
 from .plots import figure
 
 __all__ = ["data_uri", "effect_figure", "residual_figure"]
@@ -20,12 +22,22 @@ __all__ = ["data_uri", "effect_figure", "residual_figure"]
 #: Most points drawn per trace (an SVG path per point beyond that only adds bytes).
 MAX_POINTS = 2500
 
-#: Axis label and factor from SI, by abscissa name.
-ABSCISSA = {
-    "t": ("time [s]", 1.0), "time": ("time [s]", 1.0),
-    "x": ("position [mm]", 1e3), "position": ("position [mm]", 1e3),
-    "v": ("velocity [mm/s]", 1e3), "velocity": ("velocity [mm/s]", 1e3),
-}
+#: The quantity of each abscissa name.
+_QUANTITY = {"t": "time", "time": "time", "x": "position", "position": "position",
+             "v": "velocity", "velocity": "velocity"}
+
+
+def abscissa(key: str) -> tuple[str, float]:
+    """Axis label and factor from SI of an abscissa (``t``, ``x``, ``v`` or the
+    quantity's name), in the units of the axis spoken now: ``("position [mm]", 1e3)``."""
+    word = _QUANTITY[key]
+    unit, k = U.where_unit(word)
+    return f"{word} [{unit}]", k
+
+
+def _force_label(what: str = "") -> str:
+    """``"force residual [N]"``, ``"torque residual [N m]"`` on a rotary axis."""
+    return f"{U.force_words()}{' ' + what if what else ''} [{U.si('N')}]"
 
 
 def data_uri(fig: Any, dpi: int = 130) -> str:
@@ -49,13 +61,13 @@ def _legend_above(ax: Any, ncol: int) -> None:
 def axis_label(xlabel: str | None, key: str | None = None) -> tuple[str, float]:
     """Label and factor for an abscissa given by name (``x``) or by label (``position
     [m]``): SI labels become display units."""
-    if key in ABSCISSA:
-        return ABSCISSA[key]
+    if key in _QUANTITY:
+        return abscissa(key)
     if xlabel:
         low = xlabel.lower()
         for word in ("position", "velocity", "time"):
             if low.startswith(word):
-                return ABSCISSA[word]
+                return abscissa(word)
         return xlabel, 1.0
     return "", 1.0
 
@@ -74,7 +86,7 @@ def effect_figure(x: Any, residual: Any, effect: Any, xlabel: str, name: str) ->
             label="residual before the effect")
     ax.plot(k * x[idx], effect[idx], "-", lw=1.6, color="tab:red", label=f"fitted {name}")
     ax.set_xlabel(label)
-    ax.set_ylabel("force [N]")
+    ax.set_ylabel(_force_label())
     ax.grid(alpha=0.3)
     _legend_above(ax, 2)
     return data_uri(fig)
@@ -89,7 +101,7 @@ def residual_figure(x: Any, before: Any, after: Any, key: str, floor: float | No
     if mask is not None:
         m = np.asarray(mask, bool)
         x, before, after = x[m], before[m], after[m]
-    label, k = ABSCISSA[key]
+    label, k = abscissa(key)
     idx = _thin(x.size) if key == "t" else np.argsort(x, kind="stable")[_thin(x.size)]
     fig, axes = figure(1, 1, figsize=(7.5, 3.0))
     ax = axes[0, 0]
@@ -104,7 +116,7 @@ def residual_figure(x: Any, before: Any, after: Any, key: str, floor: float | No
             ax.axhline(s, color="k", ls="--", lw=0.8)
         ax.plot([], [], "k--", lw=0.8, label="±2× noise floor")
     ax.set_xlabel(label)
-    ax.set_ylabel("force residual [N]")
+    ax.set_ylabel(_force_label("residual"))
     ax.grid(alpha=0.3)
     _legend_above(ax, 3)
     return data_uri(fig)

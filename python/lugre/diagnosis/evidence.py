@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import units as U
 from ..model import Model
 from ..vocabulary import EFFECTS, is_timing
 from . import base as B
@@ -23,13 +24,14 @@ __all__ = ["could_not_reveal", "evidence", "revealed_sizes", "unexplained", "ver
 
 
 def evidence(t: Term, log: dict[str, Any], K: int, extra: str = "") -> str:
-    """The evidence of a finding in two or three sentences a person can check."""
+    """The evidence of a finding in two or three sentences a person can check (in the
+    words of the axis: torque and inertia on a rotary one)."""
     sig_txt = f"{t.cand.signature[0].upper()}{t.cand.signature[1:]}."
     if log:
         sig_txt += (f" Fitted with the friction levels on nine tenths of the record, it "
                     f"predicts the tenth left out better in {log['positive']} of {K} such "
                     f"stretches (chance of this from noise alone: p = {log['p']:.1g}).")
-    return sig_txt + (" " + extra if extra else "")
+    return U.words(sig_txt + (" " + extra if extra else ""))
 
 
 def base_report(model: Model, base: dict[str, float], free: list[str],
@@ -43,7 +45,7 @@ def base_report(model: Model, base: dict[str, float], free: list[str],
         if n in B.PRESLIDING and n not in free:
             status = "not determined by this record (held)"
         out[n] = {"before": b0, "after": b1, "change": (b1 - b0) / b0 if b0 else 0.0,
-                  "tolerance": rel, "unit": B.unit(n), "status": status}
+                  "tolerance": rel, "unit": U.si(B.unit(n)), "status": status}
     out["sigma1"]["presliding_test"] = {k: presliding[k] for k in
                                         ("gain", "min_gain", "alpha", "p", "positive",
                                          "blocks", "free")
@@ -65,7 +67,8 @@ def base_moves(base: dict[str, dict[str, Any]], factor: float = 2.0) -> list[dic
             d = b["after"] - b["before"]
             out.append({"parameter": n, "before": b["before"], "after": b["after"],
                         "unit": b["unit"],
-                        "text": (f"{n} {d:+.3g} {b['unit']} ({100 * b['change']:+.0f} %, from "
+                        "text": (f"{U.words(n)} {d:+.3g} {b['unit']} "
+                                 f"({100 * b['change']:+.0f} %, from "
                                  f"{b['before']:.4g} to {b['after']:.4g} {b['unit']})")})
     return out
 
@@ -95,19 +98,20 @@ def base_notes(base: dict[str, dict[str, Any]], findings: list[Any]) -> list[str
                    f"{pt.get('min_gain', 0.0):.3g} a finding needs; {blocks})")
         else:
             why = f"freeing them does not improve the held-out fit consistently ({blocks})"
-        notes.append(
+        notes.append(U.words(
             "sigma0 and sigma1 (presliding stiffness and damping) are held at the model's "
             f"values: {why}, so this record does not determine them. To determine them: "
             "small back-and-forth moves below the breakaway force (presliding, a few "
             "micrometres) or a small-amplitude current sweep at standstill, logged at "
-            "1 kHz or faster.")
+            "1 kHz or faster."))
     bp, bn = base["positive.fc"]["after"], base["negative.fc"]["after"]
     if not any(f.effect == Offset.effect for f in findings) and abs(bp - bn) > 0.1 * (bp + bn) / 2:
-        notes.append(
-            f"The Coulomb levels differ by direction ({bp:.3g} N forward, {bn:.3g} N "
-            f"backward); a constant force of {(bp - bn) / 2:.3g} N with a symmetric level "
+        n = U.si("N")
+        notes.append(U.words(
+            f"The Coulomb levels differ by direction ({bp:.3g} {n} forward, {bn:.3g} {n} "
+            f"backward); a constant force of {(bp - bn) / 2:.3g} {n} with a symmetric level "
             f"would fit the motion equally well. To separate: "
-            f"{ASYMMETRY_EXPERIMENT}.")
+            f"{ASYMMETRY_EXPERIMENT}."))
     return notes
 
 
@@ -141,17 +145,18 @@ def unexplained(r: np.ndarray, sig: R.Signals, floor: float, where: dict[str, An
             "hold")
     if excess is not None:
         shape.append(
-            f"the residual's noise floor, {excess['floor']:.2g} N, is "
+            f"the residual's noise floor, {excess['floor']:.2g} {U.si('N')}, is "
             f"{excess['floor'] / excess['expected']:.0f} times what the recorded current's "
             f"noise and the position reading's noise explain ({excess['expected']:.2g} "
-            "N, both measured above the motion's band): mismatch spread over the whole "
+            f"{U.si('N')}, both measured above the motion's band): mismatch spread over the whole "
             "band is counted as noise (impacts, e.g. at the reversals; an error of the "
             "position reading periodic in position, crossed at changing speeds; a ripple "
             "of the drive); effects under that floor stay hidden")
     if mass_ways is not None:
         shape.append(
-            f"the acceleration force reads as {mass_ways['speeding_up']:+.2g} kg while the "
-            f"drive speeds the axis up and {mass_ways['braking']:+.2g} kg while it brakes "
+            f"the acceleration force reads as {mass_ways['speeding_up']:+.2g} {U.si('kg')} "
+            f"while the drive speeds the axis up and {mass_ways['braking']:+.2g} "
+            f"{U.si('kg')} while it brakes "
             "(+- "
             f"{2 * max(mass_ways['speeding_up_se'], mass_ways['braking_se']):.2g}): not a "
             "payload, which is the same mass both ways, but a force that grows with the "
@@ -180,22 +185,27 @@ def unexplained(r: np.ndarray, sig: R.Signals, floor: float, where: dict[str, An
                 fast = float(np.sqrt(np.mean(rr[~slow] ** 2))) if (~slow).any() else 0.0
                 shape.append(
                     f"{100 * share_slow:.0f} % of it lies where the axis stands or moves under "
-                    f"{frac * vtop * 1e3:.2g} mm/s ({100 * frac:g} % of the top speed, "
+                    f"{_speed(frac * vtop)} ({100 * frac:g} % of the top speed, "
                     f"{100 * slow.mean():.1f} % of the time): "
-                    f"{float(np.sqrt(np.mean(rr[slow] ** 2))):.3g} N rms there against "
-                    f"{fast:.3g} N faster. The friction at standstill and low speed (static "
-                    "friction, breakaway, the Stribeck fall, presliding) is unlike the model's: "
-                    "a slow current ramp at standstill in both directions, and constant-speed "
-                    "passes at a few mm/s, measure it")
+                    f"{float(np.sqrt(np.mean(rr[slow] ** 2))):.3g} {U.si('N')} rms there "
+                    f"against {fast:.3g} {U.si('N')} faster. The friction at standstill and "
+                    "low speed (static friction, breakaway, the Stribeck fall, presliding) is "
+                    "unlike the model's: a slow current ramp at standstill in both "
+                    "directions, and constant-speed passes at "
+                    f"{'a few hundredths of a rad/s' if U.is_rotary() else 'a few mm/s'}, "
+                    "measure it")
                 break
     if d.get("positive") and d.get("negative"):
         ratio = d["positive"] / d["negative"]
         if ratio > 1.5 or ratio < 1 / 1.5:
             shape.append(f"it is {'larger moving forward' if ratio > 1 else 'larger moving backward'}"
-                         f" ({d['positive']:.3g} N against {d['negative']:.3g} N rms)")
+                         f" ({d['positive']:.3g} {U.si('N')} against {d['negative']:.3g} "
+                         f"{U.si('N')} rms)")
     parts = [f"{k} {short_ranges(where[k])}" for k in ("time", "position", "velocity")
              if where.get(k)]
-    msg = (f"after the findings the residual is still {rms1:.3g} N rms, {rms1 / floor:.1f} "
+    shape = [U.words(x) for x in shape]
+    msg = (f"after the findings the residual is still {rms1:.3g} {U.si('N')} rms, "
+           f"{rms1 / floor:.1f} "
            "times the noise floor, and no effect of the vocabulary explains the rest")
     msg += "; it lives at " + "; ".join(parts) if parts else ""
     msg += ". " + "; ".join(shape) + "." if shape else "."
@@ -355,8 +365,9 @@ def verdict(dg: Any) -> str:
     gain = ""
     carries = True
     if hb and ha and hb.get("rms_force"):
-        gain = (f" On the held-out record the force error goes from {hb['rms_force']:.3g} to "
-                f"{ha['rms_force']:.3g} N rms ({100 * (ha['rms_force'] / hb['rms_force'] - 1):+.0f} %).")
+        gain = (f" On the held-out record the {U.force_words()} error goes from "
+                f"{hb['rms_force']:.3g} to {ha['rms_force']:.3g} {U.si('N')} rms "
+                f"({100 * (ha['rms_force'] / hb['rms_force'] - 1):+.0f} %).")
         carries = not ha["rms_force"] > 1.1 * hb["rms_force"]
         if not carries:
             # the refit describes this record and not the held-out one: a record unlike
@@ -370,14 +381,14 @@ def verdict(dg: Any) -> str:
     head = (rebased["text"][0].upper() + rebased["text"][1:] + ". ") if rebased else ""
     if rebased and rebased.get("holdout_given") and ha:
         head += (f"On the held-out record the model as given misses by "
-                 f"{rebased['holdout_given']['rms_force']:.3g} N rms, the refitted base with "
-                 f"what is found below by {ha['rms_force']:.3g} N. ")
+                 f"{rebased['holdout_given']['rms_force']:.3g} {U.si('N')} rms, the refitted "
+                 f"base with what is found below by {ha['rms_force']:.3g} {U.si('N')}. ")
     if not gone:
         return head + _verdict_findings(dg, gain, carries=carries)
     # the model's own effects that the record contradicts come first: they are what the
     # user wrote, and the augmented model leaves them out
     def listed(rs: list[dict[str, Any]], who: str = "its") -> str:
-        return ", ".join(f"{who} {r['effect'].replace('_', ' ')} "
+        return ", ".join(f"{who} {U.words(r['effect'].replace('_', ' '))} "
                          f"({effect_words(r['effect'], r['parameters'])})" for r in rs)
 
     out = []
@@ -412,7 +423,7 @@ def _verdict_findings(dg: Any, gain: str, without: str = "", carries: bool = Tru
             txt = ("Unexplained: the model misses this record, but no effect of the "
                    "vocabulary accounts for it. " + dg.unexplained["message"])
         return txt + gain
-    names = ", ".join(f"{f.effect} ({_params(f)})" for f in dg.findings)
+    names = ", ".join(f"{U.words(f.effect)} ({_params(f)})" for f in dg.findings)
     one = len(dg.findings) == 1
     if not carries:
         txt = f"Found on this record: {names}.{gain}"
@@ -431,7 +442,8 @@ def _params(f: Any) -> str:
 
 
 def effect_words(effect: str, parameters: dict[str, Any]) -> str:
-    """An effect's parameters in a few words with their units ("amplitude 1 N, ...")."""
+    """An effect's parameters in a few words with the axis's units ("amplitude 1 N,
+    ...")."""
     if is_timing(effect):
         return timing_words(effect, parameters)
     spec = EFFECTS.get(effect)
@@ -439,10 +451,16 @@ def effect_words(effect: str, parameters: dict[str, Any]) -> str:
     parts = []
     for k, v in parameters.items():
         if isinstance(v, (int, float)):
-            parts.append(f"{k} {v:.3g}{' ' + units.get(k, '') if units.get(k) else ''}")
+            parts.append(f"{k} {v:.3g}{' ' + U.si(units[k]) if units.get(k) else ''}")
     sc, pos = parameters.get("scale"), parameters.get("positions")
     if sc and pos:  # a level along the stroke: its largest change
         sc = np.asarray(sc)
         j = int(np.argmax(np.abs(sc - 1)))
-        parts.append(f"level x{sc[j]:.3g} at x = {pos[j]:.3g} m")
+        parts.append(f"level x{sc[j]:.3g} at x = {pos[j]:.3g} {U.si('m')}")
     return ", ".join(parts)
+
+
+def _speed(v: float) -> str:
+    """A low speed [SI] in the display unit (mm/s, or rad/s on a rotary axis)."""
+    u, k = U.display("m/s")
+    return f"{v * k:.2g} {u}"

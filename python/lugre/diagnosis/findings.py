@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import units as U
 from ..model import Model
 from ..vocabulary import EFFECTS
 from . import base as B
@@ -182,7 +183,7 @@ def _beside_given(model: Model, e: dict[str, Any]) -> str:
     own = [g for g in model.effects if g["effect"] == e["effect"]]
     if key is None or spec is None or not own:
         return ""
-    unit = " " + spec.units[key]
+    unit = " " + U.si(spec.units[key])
     have = sum(float(g[key]) for g in own)
     return (f" The model already holds a {e['effect']} ({key} {have:+.3g}{unit}); this "
             f"corrects it: together {key} {have + float(e[key]):+.3g}{unit}.")
@@ -204,10 +205,12 @@ def origin_notes(removed: list[dict[str, Any]], findings: list[Finding]) -> list
                                   - float(r["parameters"].get("phase", 0.0)), 2 * math.pi)
             dx = dphi / (2 * math.pi) * p_old
             ratio = float(f.parameters["amplitude"]) / float(r["parameters"]["amplitude"])
+            u, k = U.position_unit()
+            phase = f"{'phase ' if U.is_rotary() else ''}{dphi:+.2f} rad"
             out.append(
-                f"The cogging found has the pitch of the model's ({p_old * 1e3:.4g} mm) and "
+                f"The cogging found has the pitch of the model's ({p_old * k:.4g} {u}) and "
                 f"{ratio:.2g} times its amplitude, at a position shift of "
-                f"{dx * 1e3:+.2g} mm ({dphi:+.2f} rad; modulo the pitch): this record's "
+                f"{dx * k:+.2g} {u} ({phase}; modulo the pitch): this record's "
                 "position origin likely differs from the one the model was made on "
                 "(homing, an encoder offset). Home the axis alike for both, or use the "
                 "phase found here for this setup.")

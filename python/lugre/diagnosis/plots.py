@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import units as U
 from .report import Diagnosis
 
 __all__ = ["PLOT_FILES", "write_plots"]
@@ -22,7 +23,8 @@ def write_plots(diagnosis: Diagnosis, out_dir: str | os.PathLike[str]) -> list[P
     Files: ``residual_time.png``, ``residual_position.png``, ``residual_velocity.png``
     (residual before and after, with the noise floor), ``residual_spectrum.png``
     (spectrum of the residual over position), ``overlay.png`` (the force residual
-    before and after, over time). Positions in mm, speeds in mm/s; legends above the axes.
+    before and after, over time). Positions in mm, speeds in mm/s (on a rotary axis rad,
+    rad/s and N m); legends above the axes.
 
     Parameters
     ----------
@@ -36,6 +38,11 @@ def write_plots(diagnosis: Diagnosis, out_dir: str | os.PathLike[str]) -> list[P
     list of Path
         The files written.
     """
+    with U.axis(diagnosis.model.kind):
+        return _write_plots(diagnosis, out_dir)
+
+
+def _write_plots(diagnosis: Diagnosis, out_dir: str | os.PathLike[str]) -> list[Path]:
     import matplotlib
 
     matplotlib.use("Agg", force=False)
@@ -68,8 +75,9 @@ def write_plots(diagnosis: Diagnosis, out_dir: str | os.PathLike[str]) -> list[P
         files.append(p)
 
     # one unit per quantity across the figures: position in mm, speed in mm/s
-    for key, label, unit, scale in (("t", "time", "s", 1.0), ("x", "position", "mm", 1e3),
-                                    ("v", "velocity", "mm/s", 1e3)):
+    f_label = f"{U.force_words()} residual [{U.si('N')}]"
+    for key, label in (("t", "time"), ("x", "position"), ("v", "velocity")):
+        unit, scale = U.where_unit(label)
         fig, ax = plt.subplots(figsize=(8, 4))
         style = "-" if key == "t" else "."
         kw = {"lw": 0.6} if key == "t" else {"ms": 1}
@@ -80,7 +88,7 @@ def write_plots(diagnosis: Diagnosis, out_dir: str | os.PathLike[str]) -> list[P
         for s in (-2 * floor, 2 * floor):
             ax.axhline(s, color="k", ls="--", lw=0.8)
         ax.set_xlabel(f"{label} [{unit}]")
-        ax.set_ylabel("force residual [N]")
+        ax.set_ylabel(f_label)
         ax.set_title(f"Residual against {label} (dashed: 2x noise floor)", loc="left",
                      pad=22)
         _legend_above(ax)
@@ -88,14 +96,15 @@ def write_plots(diagnosis: Diagnosis, out_dir: str | os.PathLike[str]) -> list[P
 
     fig, ax = plt.subplots(figsize=(8, 4))
     k = d["spectrum_k"]
+    p_unit, p_scale = U.position_unit()
     with np.errstate(divide="ignore"):
-        ax.semilogy(1.0 / k * 1e3, d["spectrum_before"], color="tab:red",
+        ax.semilogy(1.0 / k * p_scale, d["spectrum_before"], color="tab:red",
                     label="residual before")
-        ax.semilogy(1.0 / k * 1e3, d["spectrum_after"], color="tab:blue",
+        ax.semilogy(1.0 / k * p_scale, d["spectrum_after"], color="tab:blue",
                     label="residual after")
     ax.set_xscale("log")
-    ax.set_xlabel("pitch [mm]")
-    ax.set_ylabel("amplitude [N]")
+    ax.set_xlabel(f"pitch [{p_unit}]")
+    ax.set_ylabel(f"amplitude [{U.si('N')}]")
     ax.set_title("Spectrum of the residual over position", loc="left", pad=22)
     _legend_above(ax)
     save(fig, "residual_spectrum.png")
@@ -107,10 +116,11 @@ def write_plots(diagnosis: Diagnosis, out_dir: str | os.PathLike[str]) -> list[P
     ax.plot(t[m], d["before"][m], color="tab:red", lw=0.6, label="residual before")
     ax.plot(t[m], d["after"][m], color="tab:blue", lw=0.6, label="residual after")
     fb, fa = diagnosis.fit["before"], diagnosis.fit["after"]
-    ax.set_title(f"Force residual {fb['rms_force']:.3g} N -> {fa['rms_force']:.3g} N rms",
-                 loc="left", pad=22)
+    n = U.si("N")
+    ax.set_title(f"{U.force_words().capitalize()} residual {fb['rms_force']:.3g} {n} -> "
+                 f"{fa['rms_force']:.3g} {n} rms", loc="left", pad=22)
     ax.set_xlabel("time [s]")
-    ax.set_ylabel("force residual [N]")
+    ax.set_ylabel(f_label)
     _legend_above(ax)
     save(fig, "overlay.png")
     return files

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import units as U
 from ..model import Model
 from ..vocabulary import CURRENT_LAG, ONE_OF_A_KIND, kind
 from . import base as B
@@ -150,9 +151,9 @@ def _removed_entry(e: dict[str, Any], pt: dict[str, Any], why: str, *,
                  f"chance of this from noise alone: p = {pt['p']:.2g}). It is replaced: "
                  "the augmented model holds the one found."
                  + (f" What moved: {moved}." if moved else ""))
-        return {"effect": name, "parameters": e, "evidence": said, "gain": pt["gain"],
-                "p": pt["p"], "positive": pt["positive"], "blocks": pt["blocks"],
-                "replaced": True}
+        return {"effect": name, "parameters": e, "evidence": U.words(said),
+                "gain": pt["gain"], "p": pt["p"], "positive": pt["positive"],
+                "blocks": pt["blocks"], "replaced": True}
     if beside:
         said += (f"the search found {beside} of the opposite sense beside it, and the two "
                  "together do not earn their place on the held-out stretches (kept: "
@@ -164,7 +165,7 @@ def _removed_entry(e: dict[str, Any], pt: dict[str, Any], why: str, *,
                  f"{pt['gain']:.0f} in squared-error units of the noise; chance of this "
                  f"from noise alone: p = {pt['p']:.2g}). ")
     said += "It is left out of the augmented model and the record searched without it."
-    return {"effect": name, "parameters": e, "evidence": said, "gain": pt["gain"],
+    return {"effect": name, "parameters": e, "evidence": U.words(said), "gain": pt["gain"],
             "p": pt["p"], "positive": pt["positive"], "blocks": pt["blocks"]}
 
 

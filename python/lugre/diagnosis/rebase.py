@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import units as U
 from ..model import Model
 from . import residual as R
 from .base import BASE_PARAMS, apply_base, get_base
@@ -61,8 +62,9 @@ def far_base(rec: Any, given: Model, augmented: Model, *, cutoff_hz: float | Non
     moves = _moves(given, refit, names) or moved
     text = ("the base as given is far from what this record supports: "
             + ", ".join(_move_words(m) for m in moves)
-            + f"; refitted with the findings in, the force residual falls from {rms0:.3g} "
-            f"to {rms1:.3g} N rms. The search was run again from the refitted base, so "
+            + f"; refitted with the findings in, the {U.force_words()} residual falls from "
+            f"{rms0:.3g} to {rms1:.3g} {U.si('N')} rms. The search was run again from the "
+            "refitted base, so "
             "that no finding stands in for a base parameter")
     return {"model": refit, "moves": moves, "rms_given": rms0, "rms_refit": rms1,
             "text": text}

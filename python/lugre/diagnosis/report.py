@@ -184,41 +184,46 @@ class Diagnosis:
         with U.axis(self.model.kind):
             return self._summary()
 
-    def _summary(self) -> str:
-        from .evidence import effect_words
-
-        lines: list[str] = [self.verdict] if self.verdict else []
+    def _residual_lines(self) -> list[str]:
+        """The noise floor and the residual before and after the findings, in the
+        axis's units."""
         fb, fa = self.fit["before"], self.fit["after"]
-        after = self.noise.get("rms_after")
+        n, after = U.si("N"), self.noise.get("rms_after")
         # the floor is read on the base refit's residual; findings that spread over the
         # band (a lag's) can lower it a great deal, and then both are said
-        floor = (f"Noise floor {self.noise['rms']:.3g} N rms before the findings, "
-                 f"{after:.3g} N after" if after is not None and after < 0.5 * self.noise["rms"]
-                 else f"Noise floor {self.noise['rms']:.3g} N rms")
-        lines.append(
-            f"{floor} (n_eff {self.noise['n_eff']:.0f}). "
-            f"Force residual {fb['rms_force']:.3g} N -> {fa['rms_force']:.3g} N "
-            f"(nrmse {100 * fb['nrmse_force']:.2f} % -> {100 * fa['nrmse_force']:.2f} %)."
-        )
+        floor = (f"Noise floor {self.noise['rms']:.3g} {n} rms before the findings, "
+                 f"{after:.3g} {n} after" if after is not None and after < 0.5 * self.noise["rms"]
+                 else f"Noise floor {self.noise['rms']:.3g} {n} rms")
+        lines = [(f"{floor} (n_eff {self.noise['n_eff']:.0f}). "
+                  f"{U.force_words().capitalize()} residual {fb['rms_force']:.3g} {n} -> "
+                  f"{fa['rms_force']:.3g} {n} (nrmse {100 * fb['nrmse_force']:.2f} % -> "
+                  f"{100 * fa['nrmse_force']:.2f} %).")]
         if self.fit.get("holdout_before"):
             hb, ha = self.fit["holdout_before"], self.fit["holdout_after"]
             lines.append(
-                f"Hold-out: {hb['rms_force']:.3g} N -> {ha['rms_force']:.3g} N "
+                f"Hold-out: {hb['rms_force']:.3g} {n} -> {ha['rms_force']:.3g} {n} "
                 f"(nrmse {100 * hb['nrmse_force']:.2f} % -> {100 * ha['nrmse_force']:.2f} %)."
             )
         if "closed_loop" in self.fit:
             cl = self.fit["closed_loop"]
             lines.append(
                 "Closed loop (simulated under the controller vs measured): position "
-                f"{cl['before']['rms_position'] * 1e6:.3g} um -> "
-                f"{cl['after']['rms_position'] * 1e6:.3g} um rms, current "
+                f"{U.micro(cl['before']['rms_position'])} -> "
+                f"{U.micro(cl['after']['rms_position'])} rms, current "
                 f"{cl['before']['rms_current']:.3g} A -> {cl['after']['rms_current']:.3g} A rms."
             )
+        return lines
+
+    def _summary(self) -> str:
+        from .evidence import effect_words
+
+        lines: list[str] = [self.verdict] if self.verdict else []
+        lines += self._residual_lines()
         if self.rebased:
             lines.append(f"Base refitted: {self.rebased['text']}.")
         for r in self.removed:
             what = "Replaced in the model" if r.get("replaced") else "Removed from the model"
-            lines.append(f"{what}: {r['effect']}. {plain_text(r['evidence'])}")
+            lines.append(f"{what}: {U.words(r['effect'])}. {plain_text(r['evidence'])}")
         if not self.findings:
             lines.append("Findings: none beyond noise.")
         for k, f in enumerate(self.findings, 1):
@@ -232,7 +237,8 @@ class Diagnosis:
             wh = ", ".join(f"{a} {U.fmt_range(v[0], v[1], U.where_unit(a))}"
                            if isinstance(v, (list, tuple)) and len(v) == 2 else f"{a} {_fmt(v)}"
                            for a, v in f.where.items() if v is not None)
-            line = (f"{k}. {f.effect}{' (' + ps + ')' if ps else ''} explains {U.percent(f.explained)} of "
+            line = (f"{k}. {U.words(f.effect)}{' (' + ps + ')' if ps else ''} explains "
+                    f"{U.percent(f.explained)} of "
                     f"the residual{'; lives at ' + wh if wh else ''}.")
             lines.append(line.replace("\u2212", "-"))
             lines.append(f"   {plain_text(f.evidence)}")
@@ -243,15 +249,17 @@ class Diagnosis:
                         **ap, "seconds": alt.get("effective_delay_s", ap.get("seconds"))}) + ")"
                 else:
                     ap_txt = _fmt(ap)
-                lines.append(f"   Equally well: {alt['effect']} {ap_txt}. "
-                             f"To separate: {alt['experiment']}")
+                lines.append(U.words(f"   Equally well: {alt['effect']} {ap_txt}. "
+                                     f"To separate: {alt['experiment']}"))
         if self.minor:
             lines.append(
                 "Minor corrections, consistent on the held-out stretches but each under "
-                "0.3 % of the motor force (kept in the augmented model, too small to name): "
-                + "; ".join(f"{m['effect']} ({effect_words(m['effect'], m['parameters'])}; "
-                            f"{m['rms_force']:.2g} N rms)" for m in self.minor) + ".")
-        moved = [f"{n} {100 * b['change']:+.1f} %" for n, b in self.base.items()
+                f"0.3 % of the motor {U.force_words()} (kept in the augmented model, too "
+                "small to name): "
+                + "; ".join(f"{U.words(m['effect'])} "
+                            f"({effect_words(m['effect'], m['parameters'])}; "
+                            f"{m['rms_force']:.2g} {U.si('N')} rms)" for m in self.minor) + ".")
+        moved = [f"{U.words(n)} {100 * b['change']:+.1f} %" for n, b in self.base.items()
                  if abs(b["change"]) > 0.005]
         if moved:
             lines.append("Base parameters re-estimated: " + ", ".join(moved) + ".")
@@ -262,7 +270,7 @@ class Diagnosis:
         if self.unexplained:
             u = self.unexplained
             lines.append(f"Unexplained: {u['message']}")
-        lines.extend(self.notes)
+        lines.extend(U.words(n) for n in self.notes)
         return "\n".join(lines)
 
 

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
+from .. import units as U
 from ..exceptions import DataError, InputError, UnitsWarning
 from ..io import Recording
 from ..model import Model, _as_model
@@ -247,7 +248,8 @@ def check_recording(rec: Recording, model: Model | None = None) -> None:
         raise InputError.at("i", "the recording has neither the current i nor the force F")
     from ..checks import require_plausible
 
-    require_plausible(rec)  # gaps in the sampling, positions in the wrong unit
+    # gaps in the sampling, positions in the wrong unit (radians on a rotary axis)
+    require_plausible(rec, "rotary" if U.is_rotary() else None)
     med = float(np.median(np.diff(rec.t)))
     span = float(np.ptp(rec.x))
     steps = np.abs(np.diff(rec.x))
@@ -255,16 +257,19 @@ def check_recording(rec: Recording, model: Model | None = None) -> None:
     if span <= 0.0 or span < 20 * max(q, 1e-12):
         raise DataError(
             "the recording shows no motion (position range "
-            f"{span:.3g} m): a diagnosis needs the axis moving, ideally in both directions"
+            f"{span:.3g} {U.si('m')}): a diagnosis needs the axis moving, ideally in both "
+            "directions"
         )
     v = np.diff(rec.x) / med
     vmax = float(np.max(np.abs(v)))
     if model is not None:
         vs = min(model.positive["vs"], model.negative["vs"])
         if np.percentile(np.abs(v), 90) > 1000 * vs and vmax > 5.0:
+            v_u = U.si("m/s")
             warnings.warn(
-                f"speeds reach {vmax:.4g} m/s, over a thousand times the model's Stribeck "
-                f"velocity {vs:g} m/s: are the positions in millimetres?",
+                f"speeds reach {vmax:.4g} {v_u}, over a thousand times the model's Stribeck "
+                f"velocity {vs:g} {v_u}: are the positions in "
+                f"{'radians' if U.is_rotary() else 'millimetres'}?",
                 UnitsWarning,
                 stacklevel=3,
             )
@@ -713,9 +718,11 @@ def check_units(sig: Signals, model: Model) -> None:
     sf, sp = float(np.std(fm)), float(np.std(pred))
     if sp > 0 and sf > 0 and (sp / sf > 30.0) and np.ptp(sig.x) > 1.0:
         warnings.warn(
-            f"the model needs {sp:.3g} N rms where the motor gives {sf:.3g} N: the "
-            "positions look like millimetres against a model in metres; convert x to "
-            "metres (divide by 1000)",
+            f"the model needs {sp:.3g} {U.si('N')} rms where the motor gives {sf:.3g} "
+            f"{U.si('N')}: the positions look like "
+            + ("degrees against a model in radians; convert x to radians (--x-unit deg)"
+               if U.is_rotary() else "millimetres against a model in metres; convert x to "
+               "metres (divide by 1000)"),
             UnitsWarning,
             stacklevel=3,
         )

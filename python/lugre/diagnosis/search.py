@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import units as U
 from ..exceptions import LugreError
 from .candidates import Candidate, Context, Term
 from .scoring import (
@@ -248,8 +249,9 @@ def _try(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidate, ctx: 
         minor = ok and (why == "consistent over blocks" or (
             evid["p"] < 10.0 * rules.alpha and evid["positive"] >= 0.9 * evid["blocks"]))
         ok = False
-        why = (f"contribution {contrib:.2g} N rms is under {rules.min_force:.2g} N, "
-               "0.3 % of the motor force: real perhaps, but too small to matter")
+        n = U.si("N")
+        why = (f"contribution {contrib:.2g} {n} rms is under {rules.min_force:.2g} {n}, "
+               f"0.3 % of the motor {U.force_words()}: real perhaps, but too small to matter")
     if (not ok and c.minor_when_consistent and evid["gain"] >= rules.min_gain
             and contrib < rules.min_force and evid["p"] < 10.0 * rules.alpha
             and evid["positive"] >= 0.9 * evid["blocks"]):
@@ -258,7 +260,7 @@ def _try(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidate, ctx: 
         # read a 0.3 ms dead time as 0.2 ms. A small mass correction nearly consistent
         # over the blocks enters as minor, never named; the naming test is the usual one
         minor = True
-        why += "; a small mass correction, nearly consistent over the blocks"
+        why += f"; a small {U.mass_words()} correction, nearly consistent over the blocks"
     entry = {"step": step, "effect": c.effect, "h": h, **evid, "contrib": contrib,
              "accepted": False, "ok": ok, "why": why}
     return _Trial(cand=c, term=term, trial=trial, ev=ev, entry=entry, ok=ok, minor=minor,
@@ -398,7 +400,7 @@ def _take(scorer: Scorer, terms: list[Term], cur: Evaluation, best: Any,
     if held and _rms_between((None, terms, cur), best, q, m, held[0]) < practical:
         log[best[3]]["ok"] = False
         log[best[3]]["why"] += (f"; not taken: beyond the {held[0]} found it adds a "
-                                "force under the practical size (parsimony)")
+                                f"{U.force_words()} under the practical size (parsimony)")
         return terms, cur, log[best[3]]["effect"]
     for simple in (bc[4].supersedes if bc else ()):
         if simple in okays:
@@ -411,7 +413,7 @@ def _take(scorer: Scorer, terms: list[Term], cur: Evaluation, best: Any,
             if not accept(nested, alpha=rules.alpha, min_gain=rules.min_gain)[0]:
                 why = "does not pass the test against it"
             elif extra < practical:
-                why = f"adds {extra:.2g} N rms beyond it: under the practical size"
+                why = f"adds {extra:.2g} {U.si('N')} rms beyond it: under the practical size"
             else:
                 continue
             best = okays[simple][:4]

@@ -31,8 +31,13 @@ EXPERIMENTS: dict[str, str] = {
 _NATURAL_ABSCISSA = {name: spec.abscissa for name, spec in EFFECTS.items()}
 
 
+def _experiment(name: str, default: str) -> str:
+    """The experiment that determines ``name``, in the words of the axis."""
+    return U.words(EXPERIMENTS.get(name, default))
+
+
 def _effect_title(effect: str) -> str:
-    return effect.replace("_", " ")
+    return U.words(effect.replace("_", " "))
 
 
 def _list_summary(name: str, vals: list[float], unit: tuple[str, float],
@@ -58,7 +63,7 @@ def _param_rows(effect: str, params: dict[str, Any], unc: dict[str, Any]) -> lis
             lo, hi = iv
             if lo is None or hi is None or not all(math.isfinite(float(v)) for v in (lo, hi)):
                 interval = ("not determined by this record: determine it with "
-                            + EXPERIMENTS.get(effect, "a longer record"))
+                            + _experiment(effect, "a longer record"))
             else:
                 interval = U.fmt_range(lo, hi, unit)
         elif iv is None:
@@ -107,7 +112,7 @@ def _direction_text(d: dict[str, Any]) -> str | None:
     vals = [(words[k], float(v)) for k, v in d.items() if k in words and _is_num(v)]
     if not vals:
         return None
-    return ", ".join(f"{w} {v:.3g} N rms" for w, v in vals)
+    return ", ".join(f"{w} {v:.3g} {U.si('N')} rms" for w, v in vals)
 
 
 def _where_text(where: dict[str, Any] | None) -> str:
@@ -162,7 +167,8 @@ def _share_block(report: dict[str, Any]) -> str:
     rows = [[f"<span class=\"sw\" style=\"background:{_COLOURS[j % len(_COLOURS)] if j < len(shares) - 1 else '#ccd1d6'}\"></span>"
              + escape(n), f"{p} %"] for j, ((n, _), p) in enumerate(zip(shares, pct))]
     return (f"<div class=\"bar\">{bar}</div><div class=\"legend\">"
-            + _table(["share of the force residual's variance (model as given)", ""], rows, {1})
+            + _table([U.words("share of the force residual's variance (model as given)"), ""],
+                     rows, {1})
             + "</div>")
 
 
@@ -176,7 +182,8 @@ def _gain(before: dict[str, Any] | None, after: dict[str, Any] | None) -> str | 
     change = (a - b) / b if b else 0.0
     return (f"{U.fmt(b, 'N')} → {U.fmt(a, 'N')} rms ({100 * change:+.0f} %), "
             f"normalised {100 * float(before.get('nrmse_force', math.nan)):.2f} % → "
-            f"{100 * float(after.get('nrmse_force', math.nan)):.2f} % of the motor force")
+            f"{100 * float(after.get('nrmse_force', math.nan)):.2f} % of the motor "
+            f"{U.force_words()}")
 
 
 def _verdict(report: dict[str, Any]) -> tuple[str, bool]:
@@ -187,6 +194,13 @@ def _verdict(report: dict[str, Any]) -> tuple[str, bool]:
           and not report.get("rebased"))
     if report.get("verdict"):
         return str(report["verdict"]), ok
+    text, fine = _own_verdict(report, findings, fit, ok)
+    return U.words(text), fine
+
+
+def _own_verdict(report: dict[str, Any], findings: list[Any], fit: dict[str, Any],
+                 ok: bool) -> tuple[str, bool]:
+    """The verdict of a report that has none (in a linear axis's words)."""
     hold = fit.get("holdout_before") and fit.get("holdout_after")
     if not findings:
         if report.get("unexplained"):
@@ -262,7 +276,7 @@ def _finding_section(k: int, f: dict[str, Any], data: dict[str, Any] | None,
         if key in data:
             uri = _safe_figure(residual_figure, data[key], data["before"], data["after"], key,
                                floor, data.get("mask"))
-        caption = (f"Force residual before and after, against "
+        caption = (f"{U.force_words().capitalize()} residual before and after, against "
                    f"{ {'t': 'time', 'x': 'position', 'v': 'velocity'}[key] }.")
     if uri:
         out.append(_figure(uri, caption))
@@ -272,9 +286,15 @@ def _finding_section(k: int, f: dict[str, Any], data: dict[str, Any] | None,
                        if isinstance(v, (int, float)))
         out.append(f"<p><b>Fits as well:</b> {escape(_effect_title(str(alt.get('effect'))))}"
                    f"{' (' + escape(ps) + ')' if ps else ''}. <b>To tell them apart:</b> "
-                   f"{escape(str(alt.get('experiment') or EXPERIMENTS.get(str(alt.get('effect')), 'a second record')))}</p>")
+                   f"{escape(_alt_experiment(alt))}</p>")
     out.append("</section>")
     return "\n".join(out)
+
+
+def _alt_experiment(alt: dict[str, Any]) -> str:
+    """The experiment that tells a look-alike from the finding, in the axis's words."""
+    exp = alt.get("experiment") or _experiment(str(alt.get("effect")), "a second record")
+    return U.words(str(exp))
 
 
 _PARAM_WORD = re.compile(r"\b(sigma0|sigma1|sigma2|mass|force_constant|fc|fs|vs)\b")
@@ -288,7 +308,7 @@ def _with_experiment(note: str) -> str:
     names = list(dict.fromkeys(_PARAM_WORD.findall(note)))
     if not names:
         return note
-    exps = list(dict.fromkeys(EXPERIMENTS[n] for n in names))
+    exps = list(dict.fromkeys(_experiment(n, "") for n in names))
     return (note.rstrip() + (" " if note.rstrip().endswith(".") else ". ")
             + f"To determine {', '.join(names)}: " + "; ".join(exps) + ".")
 
@@ -299,7 +319,8 @@ def _base_moves(report: dict[str, Any]) -> list[list[str]]:
     if moves:
         for m in moves:
             unit = U.display(m.get("unit")) if m.get("unit") else U.unit_of(None, str(m.get("parameter")))
-            rows.append([escape(str(m.get("parameter"))), escape(U.fmt(m.get("before"), unit)),
+            rows.append([escape(U.words(str(m.get("parameter")))),
+                         escape(U.fmt(m.get("before"), unit)),
                          escape(U.fmt(m.get("after"), unit)), escape(str(m.get("text") or ""))])
         return rows
     for name, b in (report.get("base") or {}).items():
@@ -319,8 +340,8 @@ def _base_moves(report: dict[str, Any]) -> list[list[str]]:
                 base = name.rsplit(".", 1)[-1]
                 text += (f" (beyond the ±{100 * float(tol):.1f} % the record determines: "
                          f"poorly determined here; to pin it down, "
-                         f"{EXPERIMENTS.get(base, 'a longer record')})")
-        rows.append([escape(name.replace("_", " ")), escape(U.fmt(b.get("before"), unit)),
+                         f"{_experiment(base, 'a longer record')})")
+        rows.append([escape(U.words(name.replace("_", " "))), escape(U.fmt(b.get("before"), unit)),
                      escape(U.fmt(b.get("after"), unit)), escape(text)])
     return rows
 
@@ -338,7 +359,7 @@ def _could_not_reveal(report: dict[str, Any]) -> str:
         rng = c.get("range")
         rng_s = (U.fmt_range(rng[0], rng[1], unit) if isinstance(rng, (list, tuple))
                  and len(rng) == 2 else escape(str(rng or "–")))
-        exp = c.get("experiment") or EXPERIMENTS.get(str(c.get("effect")), "a longer record")
+        exp = c.get("experiment") or _experiment(str(c.get("effect")), "a longer record")
         rows.append([escape(_effect_title(str(c.get("effect")))), escape(smallest),
                      escape(rng_s), escape(str(c.get("text") or "")), escape(str(exp))])
     return _table(["effect", "smallest it would have seen", "range", "why", ("experiment "
@@ -394,7 +415,8 @@ def _diagnosis_page(report: dict[str, Any], data: dict[str, Any] | None, *,
                          f"{100 * float(m.get('nrmse_force') or 0.0):.2f} %"])
     if floor is not None:
         rows.append(["noise floor", escape(U.fmt(floor, "N")), "–"])
-    body.append(_table(["", "force residual (rms)", "of the motor force (rms)"], rows, {1, 2}))
+    body.append(_table(["", U.words("force residual (rms)"),
+                        U.words("of the motor force (rms)")], rows, {1, 2}))
     if findings or fit.get("after"):
         body.append(_share_block(report))
 
@@ -410,7 +432,7 @@ def _diagnosis_page(report: dict[str, Any], data: dict[str, Any] | None, *,
         body.append(_p("The base of the model as given is far from what this record "
                        "supports; the search ran from the refitted base, so that no finding "
                        "stands in for a base parameter."))
-        rows = [[escape(str(m.get("name"))), escape(f"{float(m.get('given', 0)):.4g}"),
+        rows = [[escape(U.words(str(m.get("name")))), escape(f"{float(m.get('given', 0)):.4g}"),
                  escape(f"{float(m.get('refit', 0)):.4g}"),
                  escape(f"{100 * float(m.get('change', 0)):+.0f} %")]
                 for m in rebased["moves"] if isinstance(m, dict)]
@@ -433,7 +455,7 @@ def _diagnosis_page(report: dict[str, Any], data: dict[str, Any] | None, *,
     hg = _gain(fit.get("holdout_before"), fit.get("holdout_after"))
     if hg:
         body.append(_p(f"On the second run ({holdout or 'hold-out record'}), which the fit "
-                       f"never saw, the force residual goes {hg}."))
+                       f"never saw, the {U.force_words()} residual goes {hg}."))
     else:
         body.append(_p("No second run was given: the findings were checked on held-out "
                        "stretches of this record only. Record the same motion again and "
@@ -454,16 +476,17 @@ def _diagnosis_page(report: dict[str, Any], data: dict[str, Any] | None, *,
     minor = report.get("minor")
     if isinstance(minor, list) and minor:
         body.append("<h2>Minor corrections</h2>")
-        body.append(_p("Consistent on the held-out stretches, but each under 0.3 % of the "
-                       "motor force: kept in the augmented model so that they do not bend "
+        body.append(_p(f"Consistent on the held-out stretches, but each under 0.3 % of the "
+                       f"motor {U.force_words()}: kept in the augmented model so that they do "
+                       "not bend "
                        "the findings, too small to name as missing physics."))
         rows = [[escape(_effect_title(str(m.get("effect")))),
                  escape(", ".join(f"{k} {v:.4g}" if isinstance(v, (int, float)) else f"{k} {v}"
                                   for k, v in (m.get("parameters") or {}).items()
                                   if not isinstance(v, list))),
-                 escape(U.fmt(m.get("rms_force"), ("N", 1.0)))]
+                 escape(U.fmt(m.get("rms_force"), "N"))]
                 for m in minor if isinstance(m, dict)]
-        body.append(_table(["effect", "parameters", "rms force"], rows, {2}))
+        body.append(_table(["effect", "parameters", f"rms {U.force_words()}"], rows, {2}))
 
     body.append("<h2>What this record could not have revealed</h2>")
     body.append(_could_not_reveal(report))
@@ -487,10 +510,10 @@ def _diagnosis_page(report: dict[str, Any], data: dict[str, Any] | None, *,
             if key in data:
                 uri = _safe_figure(residual_figure, data[key], data["before"], data["after"],
                                    key, floor, data.get("mask"))
-                body.append(_figure(uri, f"Force residual against {name}; dashed: twice the "
-                                         "noise floor."))
+                body.append(_figure(uri, f"{U.force_words().capitalize()} residual against "
+                                         f"{name}; dashed: twice the noise floor."))
 
-    notes = [_with_experiment(str(n)) for n in report.get("notes") or []]
+    notes = [U.words(_with_experiment(str(n))) for n in report.get("notes") or []]
     if notes:
         body.append("<h2>Notes</h2><ul>" + "".join(f"<li>{escape(n)}</li>" for n in notes)
                     + "</ul>")

@@ -16,13 +16,18 @@ __all__ = ["fit_page", "static_fit_page"]
 # --------------------------------------------------------------------------------------
 
 
+#: The axis's parameters (a linear or a rotary axis's) and the base parameter each is.
+_AXIS_ROWS = (("mass", "mass"), ("inertia", "mass"), ("force_constant", "force_constant"),
+              ("torque_constant", "force_constant"))
+
+
 def _model_rows(doc: dict[str, Any]) -> list[list[str]]:
     rows = []
     axis = doc.get("axis") or {}
     fr = doc.get("friction") or {}
-    for name in ("mass", "force_constant"):
+    for name, base in _AXIS_ROWS:
         if name in axis:
-            rows.append([name.replace("_", " "), escape(U.fmt(axis[name], U.base_unit(name)))])
+            rows.append([name.replace("_", " "), escape(U.fmt(axis[name], U.base_unit(base)))])
     for name in ("sigma0", "sigma1"):
         if name in fr:
             rows.append([name, escape(U.fmt(fr[name], U.base_unit(name)))])
@@ -46,17 +51,19 @@ def _stribeck_uri(doc: dict[str, Any], v: Any = None, F: Any = None,
         vmax = float(np.max(np.abs(v))) if v is not None and len(v) else 20 * max(
             m.positive["vs"], m.negative["vs"])
         grid = np.linspace(-vmax, vmax, 801)
-        series = [(1e3 * grid, stribeck(grid, m), "-", "fitted steady-state friction")]
+        vu, k = U.display("m/s")
+        series = [(k * grid, stribeck(grid, m), "-", "fitted steady-state friction")]
         if v is not None and F is not None:
             va, Fa = np.asarray(v, float), np.asarray(F, float)
             bad = np.zeros(va.size, bool)
             if rejected is not None and len(rejected):
                 bad[np.asarray(rejected, int)] = True
-            series.insert(0, (1e3 * va[~bad], Fa[~bad], "o", "steady-state points"))
+            series.insert(0, (k * va[~bad], Fa[~bad], "o", "steady-state points"))
             if bad.any():
-                series.insert(1, (1e3 * va[bad], Fa[bad], "x",
+                series.insert(1, (k * va[bad], Fa[bad], "x",
                                   "rejected as gross errors"))
-        return curve_figure(series, "velocity [mm/s]", "friction force [N]")
+        return curve_figure(series, f"velocity [{vu}]",
+                            f"friction {U.force_words()} [{U.si('N')}]")
     except (ValueError, KeyError, TypeError):
         return None
 
@@ -64,7 +71,13 @@ def _stribeck_uri(doc: dict[str, Any], v: Any = None, F: Any = None,
 def static_fit_page(fit: Any, v: Any, F: Any, model: dict[str, Any], *,
                     source: str | None = None, assumed: list[str] | None = None) -> str:
     """``lugre fit-static``: the Stribeck parameters with their 95 % intervals, the
-    rejected points and the curve over the points."""
+    rejected points and the curve over the points (in the units of the model's axis)."""
+    with U.axis(str((model.get("axis") or {}).get("kind", "linear"))):
+        return _static_fit_page(fit, v, F, model, source=source, assumed=assumed)
+
+
+def _static_fit_page(fit: Any, v: Any, F: Any, model: dict[str, Any], *,
+                     source: str | None, assumed: list[str] | None) -> str:
     body = []
     rows = []
     for d, label in (("positive", "v ≥ 0"), ("negative", "v < 0")):
@@ -97,7 +110,7 @@ def _ident_rows(params: dict[str, Any]) -> list[list[str]]:
 
     rows = []
     for name, p in params.items():
-        unit = str(p.get("unit", ""))
+        unit = U.si(str(p.get("unit", "")))
         lo, hi = (p.get("ci95") or [None, None])
         ends = [("open" if x is None else f"{float(x):.4g}") for x in (lo, hi)]
         rows.append([escape(label(name)), escape(f"{float(p['value']):.4g} {unit}"),
@@ -124,18 +137,20 @@ def _fit_page(model: dict[str, Any], rec: Any, *, source: str | None,
         far = bool(ident.get("far_from_floor"))
         head = "Check first." if far else "Result."
         body.append(f"<div class=\"verdict{'' if far else ' ok'}\"><b>{head}</b> The identified "
-                    f"model explains the motor force to {100 * float(ident['nrmse_force']):.2f} "
-                    f"% rms; {escape(str(ident['summary']))}.</div>")
+                    f"model explains the motor {U.force_words()} to "
+                    f"{100 * float(ident['nrmse_force']):.2f} % rms; "
+                    f"{escape(str(ident['summary']))}.</div>")
     elif nrmse:
         best = min(v for v in nrmse.values() if v is not None)
-        body.append(f"<div class=\"verdict ok\"><b>Result.</b> The identified model explains the "
-                    f"motor force to {100 * best:.2f} % rms (force residual over motor force). "
-                    "Next: check it on a second run with lugre evaluate, or look for missing "
-                    "physics with lugre diagnose.</div>")
+        body.append("<div class=\"verdict ok\"><b>Result.</b> The identified model "
+                    + U.words(f"explains the motor force to {100 * best:.2f} % rms (force "
+                              "residual over motor force). ")
+                    + "Next: check it on a second run with lugre evaluate, or look for "
+                    "missing physics with lugre diagnose.</div>")
     if nrmse:
         rows = [[escape(k), f"{100 * float(v):.2f} %"] for k, v in nrmse.items() if v is not None]
-        body.append("<h2>Force residual</h2>")
-        body.append(_table(["step", "of the motor force (rms)"], rows, {1}))
+        body.append(f"<h2>{U.force_words().capitalize()} residual</h2>")
+        body.append(_table(["step", f"of the motor {U.force_words()} (rms)"], rows, {1}))
     if ident.get("parameters"):
         body.append("<h2>What the record determines</h2>")
         body.append(_table(["parameter", "value", "95 % interval", "determined"],

@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from ... import units as U
 from ...vocabulary import DRAG, MASS, OFFSET, SPRING
 from .. import base as B
 from .. import residual as R
@@ -48,7 +49,7 @@ class Offset(Candidate):
 
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
         b = float(sizes([np.ones(len(ctx.sig))])[0])
-        return hide(self.effect, b, "N", f"a constant force {under(b, '{:.2g} N')}",
+        return hide(self.effect, b, "N", f"a constant force {under(b, _u('{:.2g}', 'N'))}",
                     experiment=("per-direction friction levels absorb a constant force "
                                 "while the axis moves; " + ASYMMETRY_EXPERIMENT.split(":")[0]
                                 + " separates them"))
@@ -87,8 +88,9 @@ class Spring(Candidate):
         sig = ctx.sig
         b = float(sizes([sig.x - np.mean(sig.x[sig.mask])])[0])
         span = ctx.xrange[1] - ctx.xrange[0]
-        return hide(self.effect, b, "N/m", f"a spring {under(b, '{:.3g} N/m')}"
-                    + (f" ({b * span:.2g} N over the stroke)" if np.isfinite(b) else ""))
+        return hide(self.effect, b, "N/m", f"a spring {under(b, _u('{:.3g}', 'N/m'))}"
+                    + (f" ({b * span:.2g} {U.si('N')} over the stroke)" if np.isfinite(b)
+                       else ""))
 
 
 class Mass(Candidate):
@@ -111,8 +113,9 @@ class Mass(Candidate):
     def refusal(self, chk: dict[str, Any]) -> str | None:
         if not chk["not_payload"]:
             return None
-        return (f"{chk['speeding_up']:+.2g} kg speeding up, {chk['braking']:+.2g} kg "
-                "braking (no payload)")
+        kg = U.si("kg")
+        return U.words(f"{chk['speeding_up']:+.2g} {kg} speeding up, {chk['braking']:+.2g} "
+                       f"{kg} braking (no payload)")
 
     def finding(self, term: Any, beta: np.ndarray, effect: dict[str, Any],
                 view: FindingView) -> Said:
@@ -122,7 +125,7 @@ class Mass(Candidate):
 
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
         b = float(sizes([ctx.sig.a])[0])
-        return hide(self.effect, b, "kg", f"a payload {under(b, '{:.2g} kg')}")
+        return hide(self.effect, b, "kg", f"a payload {under(b, _u('{:.2g}', 'kg'))}")
 
 
 class Drag(Candidate):
@@ -146,7 +149,13 @@ class Drag(Candidate):
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
         sig = ctx.sig
         b = float(sizes([sig.filt(np.abs(sig.v) * sig.v)])[0])
-        return hide(self.effect, b, "N s^2/m^2", f"a drag {under(b, '{:.3g} N s^2/m^2')}")
+        return hide(self.effect, b, "N s^2/m^2",
+                    f"a drag {under(b, _u('{:.3g}', 'N s^2/m^2'))}")
+
+
+def _u(number: str, unit: str) -> str:
+    """A format for a number in the axis's unit for the linear SI ``unit``."""
+    return f"{number} {U.si(unit)}"
 
 
 def _moves(beta: np.ndarray, names: list[str], tol: np.ndarray) -> dict[str, float]:
@@ -183,10 +192,11 @@ def offset_alternative(view: FindingView) -> tuple[dict[str, Any] | None, str]:
               for n in _OFFSET_LEVELS if n in names}
     alt_levels = {n: B.get_base(model, n) + alt.beta[names.index(n)]
                   for n in _OFFSET_LEVELS if n in names}
-    alt_txt = ", ".join(f"{n} {v:.3g} N" for n, v in alt_levels.items())
+    n_u = U.si("N")
+    alt_txt = ", ".join(f"{n} {v:.3g} {n_u}" for n, v in alt_levels.items())
     verdict = ("fit the held-out blocks about as well" if d_fit <= 3.0 * min_gain else
                f"fit the held-out blocks worse by {d_fit:.0f} (chi-square)")
-    txt = (f"Parsimony: one parameter (offset {force:.3g} N, {len(big_off)} base parameters "
+    txt = (f"Parsimony: one parameter (offset {force:.3g} {n_u}, {len(big_off)} base parameters "
            f"moved by over one tolerance, sum of squared moves {cost_off:.0f}) against "
            f"asymmetric Coulomb/static levels ({alt_txt}), which move {len(big_alt)} base "
            f"parameters by over one tolerance (sum of squared moves {cost_alt:.0f}) and "
@@ -201,9 +211,9 @@ def offset_alternative(view: FindingView) -> tuple[dict[str, Any] | None, str]:
         "parameters": {**{n: float(v) for n, v in alt_levels.items()},
                        "moves_in_tolerances": {n: round(v, 2) for n, v in big_alt.items()}},
         "note": (f"Coulomb/static levels shifted by direction ({alt_txt}, against "
-                 f"{', '.join(f'{n} {v:.3g} N' for n, v in levels.items())} with the "
+                 f"{', '.join(f'{n} {v:.3g} {n_u}' for n, v in levels.items())} with the "
                  "offset) fit the motion about as well but move more parameters"),
-        "experiment": ASYMMETRY_EXPERIMENT,
+        "experiment": U.words(ASYMMETRY_EXPERIMENT),
     }, txt
 
 
@@ -228,9 +238,9 @@ def rest_evidence(sig: R.Signals, min_s: float = 0.2) -> str:
         return ""
     means = [float(np.mean(sig.fm_f[a:b])) for a, b in runs]
     tot = sum(b - a for a, b in runs) / sig.fs
-    return (f"At rest ({len(runs)} stretches, {tot:.2g} s) the motor force averages "
-            f"{np.mean(means):.3g} N (friction can hold any force up to the static level "
-            "there, so this bounds rather than measures the offset).")
+    return U.words(f"At rest ({len(runs)} stretches, {tot:.2g} s) the motor force averages "
+                   f"{np.mean(means):.3g} {U.si('N')} (friction can hold any force up to the "
+                   "static level there, so this bounds rather than measures the offset).")
 
 
 def mass_both_ways(scorer: Any, terms: list[Any], k: int, ev: Any,
@@ -282,6 +292,7 @@ def mass_alternative(delta: float, mass: float, sig: R.Signals,
     brake = float(np.mean((sig.fm_f * sig.vf)[m] < 0)) if m.any() else 0.0
     if brake >= 0.05 or delta <= 0:
         return None
-    return {"effect": "friction growing with the drive force (outside the vocabulary)",
+    return {"effect": U.words("friction growing with the drive force (outside the "
+                              "vocabulary)"),
             "parameters": {"mu": float(delta / mass), "braking_share": brake},
-            "experiment": FORCE_FRICTION_EXPERIMENT}
+            "experiment": U.words(FORCE_FRICTION_EXPERIMENT)}

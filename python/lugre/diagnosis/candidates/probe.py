@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from ... import units as U
 from .. import residual as R
 
 __all__ = ["amps", "hide", "rate_noise_power", "refit_on", "reversals", "share", "start_of",
@@ -72,10 +73,13 @@ def under(b: float, fmt: str) -> str:
 
 def hide(effect: str, b: float, unit: str, what: str, rng: Any = None,
          experiment: str = "") -> dict[str, Any]:
-    """An entry of what the record could not have revealed."""
+    """An entry of what the record could not have revealed (``unit`` a linear axis's SI
+    unit, ``what`` and ``experiment`` in a linear axis's words: both said in the axis's
+    own)."""
     verb = "would not be seen in" if np.isfinite(b) else "cannot be seen in"
-    return {"effect": effect, "smallest": b if np.isfinite(b) else None, "unit": unit,
-            "range": rng, "experiment": experiment, "text": f"{what} {verb} this record"}
+    return {"effect": effect, "smallest": b if np.isfinite(b) else None, "unit": U.si(unit),
+            "range": rng, "experiment": U.words(experiment),
+            "text": U.words(f"{what} {verb} this record")}
 
 
 def amps(a: float) -> str:

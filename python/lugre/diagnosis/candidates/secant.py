@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from ... import units as U
 from ...model import Model
 from ...vocabulary import DEADBAND, STRIBECK_SHAPE, is_timing
 from .. import residual as R
@@ -148,11 +149,12 @@ class Deadband(_Secant):
     def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
         d = self.from_secant(h, float(beta[0]))
         force = d * ctx.model.force_constant
+        n = U.si("N")
         if _force_recorded(ctx):  # (no current was logged: the band reads as a force)
-            return (f"Motor forces under {force:.3g} N give no force at the axis (lost at "
+            return (f"Motor forces under {force:.3g} {n} give no force at the axis (lost at "
                     "each sign change of the drive's force).")
         return (f"Currents under {d * 1e3:.3g} mA give no force ({force:.3g}"
-                " N of motor force lost at each sign change of the current).")
+                f" {n} of motor force lost at each sign change of the current).")
 
     def figure(self, residual: np.ndarray, contrib: np.ndarray, ctx: Context
                ) -> dict[str, Any]:
@@ -178,12 +180,12 @@ class Deadband(_Secant):
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
         d0 = 0.02
         b = d0 * float(sizes([self.columns(d0, ctx)[:, 0]])[0])
-        kf = ctx.model.force_constant
+        kf, n = ctx.model.force_constant, U.si("N")
         if _force_recorded(ctx):  # (no current was logged: the band reads as a force)
-            return hide(self.effect, b * kf, "N", (f"a dead-band under {b * kf:.2g} N of motor "
-                                                   "force" if np.isfinite(b)
+            return hide(self.effect, b * kf, "N", (f"a dead-band under {b * kf:.2g} {n} of "
+                                                   "motor force" if np.isfinite(b)
                                                    else "a dead-band of any size"))
-        return hide(self.effect, b, "A", (f"a dead-band under {amps(b)} ({b * kf:.2g} N of "
+        return hide(self.effect, b, "A", (f"a dead-band under {amps(b)} ({b * kf:.2g} {n} of "
                                           "motor force)" if np.isfinite(b)
                                           else "a dead-band of any size"))
 
