@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from ... import units as U
 from ...vocabulary import COGGING, POSITION_FRICTION
 from ..residual import position_sums
 from .base import Candidate, Context, by
@@ -80,8 +81,9 @@ class Cogging(Candidate):
         return 1.0 / k1
 
     def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
-        return (f"The residual's spectrum over position peaks at a pitch of {h * 1e3:.4g} mm "
-                f"(searched from {1e3 / self.kmax(ctx):.3g} mm, what the slowest fifth of "
+        u, k = U.position_unit()
+        return (f"The residual's spectrum over position peaks at a pitch of {h * k:.4g} {u} "
+                f"(searched from {k / self.kmax(ctx):.3g} {u}, what the slowest fifth of "
                 "the motion resolves in the filter band, to the stroke).")
 
     figure = by("x", "position [m]")
@@ -104,17 +106,19 @@ class Cogging(Candidate):
         seen = np.isfinite(amps)
         b = float(np.max(amps[seen])) if seen.any() else float("inf")
         blind = ""
+        u, k = U.position_unit()
         if seen.any() and not seen.all():
-            pb = 1e3 / ks[~seen]
+            pb = k / ks[~seen]
             blind = (f" (of any size at pitches near {pb.min():.3g} to {pb.max():.3g} "
-                     "mm: what the friction levels cannot absorb lies in one "
+                     f"{u}: what the friction levels cannot absorb lies in one "
                      "held-out stretch)")
-        txt = (f"a cogging {under(b, '{:.2g} N')} at pitches {1e3 / ks[-1]:.3g} to "
-               f"{1e3 / ks[0]:.3g} mm{blind}, or any at pitches under "
-               f"{1e3 / kmax:.3g} mm (faster than the filter band at this record's "
+        txt = (f"a cogging {under(b, '{:.2g} ' + U.si('N'))} at pitches {k / ks[-1]:.3g} to "
+               f"{k / ks[0]:.3g} {u}{blind}, or any at pitches under "
+               f"{k / kmax:.3g} {u} (faster than the filter band at this record's "
                "slowest motion),")
+        slow = "a few hundredths of a rad/s" if U.is_rotary() else "a few mm/s"
         return hide(self.effect, b, "N", txt, experiment=(
-            "slow constant-speed passes (a few mm/s) show short pitches"))
+            f"slow constant-speed passes ({slow}) show short pitches"))
 
     def where(self, h: Any, beta: np.ndarray, ctx: Context) -> dict[str, Any]:
         return {"position": list(ctx.xrange), "time": None, "velocity": None}
