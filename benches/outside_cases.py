@@ -1,12 +1,14 @@
-"""Write diagnosis cases whose mismatch is physics OUTSIDE the vocabulary, from a plant
-written here independently of the crate (its own LuGre step, PID and integrator), in
-the layout of ../shared/datasets/mismatch with truth ``{"effect": "unmodelled"}``:
+"""Write diagnosis cases from a plant written here independently of the crate (its own
+LuGre step, PID and integrator), in the layout of ../shared/datasets/mismatch: physics
+OUTSIDE the vocabulary, with truth ``{"effect": "unmodelled"}``, and this plant's own
+versions of three effects the vocabulary has since taken in (``force_ripple``,
+``load_friction``, ``saturation`` as ``current_limit``), with their truth:
 
     python benches/outside_cases.py OUT_DIR [--quick]
     python ../shared/tools/score_diagnosis.py OUT_DIR - $(which lugre)
 
-The right answer on each is no vocabulary finding and the "unexplained" flag, with
-where the rest lives. A clean record from the same plant checks that the plant itself
+The right answer on an unmodelled case is no vocabulary finding and the
+"unexplained" flag, with where the rest lives; on the others, the effect named. A clean record from the same plant checks that the plant itself
 does not read as a mismatch. Kinds:
 
 - ``backlash``: a gap between motor and load (friction on the load, encoder on the
@@ -33,6 +35,8 @@ from pathlib import Path
 import numpy as np
 
 M, KF = 25.0, 25.0
+#: The magnet pitch of the force ripple [m].
+RIPPLE_PITCH = 0.032
 SETS = {1: (28.7, 60.2, 332.5, 0.01), -1: (28.5, 60.1, 333.0, 0.01)}
 S0, S1 = 1e5, 31.62
 KP, KI, KD, RATE = 5e4, 5e5, 1500.0, 10000.0
@@ -80,7 +84,7 @@ def plant(kind: str, xr: np.ndarray, size: float) -> tuple[np.ndarray, np.ndarra
         i_cmd = u / KF
         force = KF * i_cmd
         if kind == "force_ripple":
-            force *= 1.0 + size * math.sin(2 * math.pi * x / 0.032 + 0.4)
+            force *= 1.0 + size * math.sin(2 * math.pi * x / RIPPLE_PITCH + 0.4)
         elif kind == "saturation":
             if abs(force) > size:
                 integ -= e * dt  # anti-windup: the integrator holds while saturated
@@ -154,9 +158,22 @@ def write(out: Path, name: str, kind: str, size: float, seed: int, duration: flo
         np.savetxt(d / fn, np.column_stack(list(r.values())), delimiter=",",
                    header=",".join(r), comments="", fmt="%.9g")
     (d / "model.json").write_text(json.dumps(believed(seed), indent=1))
-    effects = [] if kind == "clean" else [{"effect": "unmodelled", "kind": kind, "size": size}]
+    effects = [] if kind == "clean" else [truth_of(kind, size)]
     (d / "truth.json").write_text(json.dumps({"effects": effects, "setup": {
         "trajectory": traj, "duration": duration, "seed": seed}}, indent=1))
+
+
+def truth_of(kind: str, size: float) -> dict:
+    """The truth of a case: the vocabulary's effect for the kinds it now holds (this
+    plant's own versions of them, an independent check), else ``unmodelled``."""
+    if kind == "force_ripple":
+        return {"effect": "force_ripple", "amplitude": size, "pitch": RIPPLE_PITCH,
+                "phase": 0.4}
+    if kind == "load_friction":
+        return {"effect": "load_friction", "coefficient": size}
+    if kind == "saturation":
+        return {"effect": "current_limit", "current": size / KF}
+    return {"effect": "unmodelled", "kind": kind, "size": size}
 
 
 #: name, kind, size, trajectory of each case written by :func:`main`

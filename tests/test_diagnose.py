@@ -242,22 +242,22 @@ def test_bristles_at_the_sample_instants():
     assert e_new < 0.3 * e_old, (e_new, e_old)
 
 
-def test_physics_outside_the_vocabulary_is_unexplained():
-    """A force-constant ripple along the stroke (the recorded current is the actual one
-    times 1 + 5 % sin(2 pi x / 30 mm)) is no effect of the vocabulary: position_friction
-    resembles it in part, but the rest stays far above the noise, so the diagnosis says
-    unexplained, where, and what it resembles, and names nothing."""
+def test_a_current_logged_through_a_rippling_force_constant_is_a_force_ripple():
+    """The recorded current is the actual one times 1 + 5 % sin(2 pi x / 30 mm): the
+    force the axis gets is the recorded current's times 1/(1 + 5 % sin), a force
+    ripple of about 5 % at a 30 mm pitch (position_friction resembles it in part)."""
     from lugre.diagnosis.synth import case
 
     rec, _hold, believed, _ = case([], seed=900, kind="sines", duration=20.0)
     g = 1 + 0.05 * np.sin(2 * np.pi * rec.x / 0.03)
     rec = lugre.Recording(t=rec.t, x=rec.x, i=rec.i * g, x_ref=rec.x_ref)
     dg = diagnose(rec, believed, closed_loop=False)
-    assert dg.findings == []
-    u = dg.unexplained
-    assert u is not None and u["where"]["position"]
-    assert [r["effect"] for r in u["resembles"]] == ["position_friction"]
-    assert dg.verdict.startswith("Unexplained")
+    assert [f.effect for f in dg.findings] == ["force_ripple"], dg.summary()
+    p = dg.findings[0].parameters
+    assert p["pitch"] == pytest.approx(0.03, rel=0.03)
+    assert p["amplitude"] == pytest.approx(0.05, rel=0.3)
+    # 1/(1 + a sin(u)) ~ 1 + a sin(u + pi): the phase is half a turn off
+    assert abs((p["phase"] - np.pi + np.pi) % (2 * np.pi) - np.pi) < 0.3
 
 
 @pytest.mark.parametrize("effect", ["none", "cogging"])

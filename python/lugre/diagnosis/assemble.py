@@ -114,7 +114,8 @@ def _hidden(w: Weighing, sel: Selection, ev: Evidence, opts: Options) -> Any:
     terms = ev.joint.terms
     kept = {t.effect for t in terms}
     return V.could_not_reveal(sel.base.scorer, ev.joint.ctx,
-                              [c for c in E.candidates() if c.effect not in sel.held_kinds],
+                              [c for c in E.candidates(w.model.kind)
+                               if c.effect not in sel.held_kinds],
                               [t.effect for t in terms if not t.minor], opts.min_gain,
                               terms=[t for t in sel.terms if t.effect in kept],
                               alpha=opts.alpha, noise_rms=w.noise["rms"],

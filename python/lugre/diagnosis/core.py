@@ -21,6 +21,7 @@ from .assemble import assemble
 from .evaluation import as_recording, evaluate, level_shift, level_shift_text
 from .findings import gather
 from .joint import Joint, refit
+from .masschange import name_mass_change
 from .options import (
     EXCESS_FLOOR,
     IDENTIFY_TOLERANCE,
@@ -136,6 +137,9 @@ def diagnose(
                           "given": first.fit["before"],
                           "holdout_given": first.fit["holdout_before"] or None}
             dg.verdict = V.verdict(dg)
+    if "mass" in fitted:
+        with U.axis(model.kind):
+            dg = name_mass_change(dg, model, rec, cutoff_hz=cutoff_hz, backend=backend)
     if fitted:
         dg.notes.append(
             "The model's base was identified by lugre fit (its file says so): its friction "

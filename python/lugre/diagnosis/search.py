@@ -242,16 +242,19 @@ def _try(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidate, ctx: 
     if ok and contrib < rules.min_effect * rules.noise_rms:
         ok, why = False, "contribution small against the noise floor"
     minor = False
-    if ok and contrib < rules.min_force and not c.timing:
+    least = rules.min_force * c.least_force
+    if ok and contrib < least and not c.timing:
         # (timing matters for the loop's phase margin, not for its force rms)
         # a minor correction is not named, only kept from leaking into other terms:
         # consistent at ten times the naming level, in nine of ten blocks
-        minor = ok and (why == "consistent over blocks" or (
+        minor = ok and c.may_be_minor and (why == "consistent over blocks" or (
             evid["p"] < 10.0 * rules.alpha and evid["positive"] >= 0.9 * evid["blocks"]))
         ok = False
         n = U.si("N")
-        why = (f"contribution {contrib:.2g} {n} rms is under {rules.min_force:.2g} {n}, "
-               f"0.3 % of the motor {U.force_words()}: real perhaps, but too small to matter")
+        why = (f"contribution {contrib:.2g} {n} rms is under {least:.2g} {n}, "
+               f"{0.3 * c.least_force:.2g} % of the motor {U.force_words()}: real perhaps, "
+               "but too small to matter" + (f" ({c.least_force_why})" if c.least_force_why
+                                            else ""))
     if (not ok and c.minor_when_consistent and evid["gain"] >= rules.min_gain
             and contrib < rules.min_force and evid["p"] < 10.0 * rules.alpha
             and evid["positive"] >= 0.9 * evid["blocks"]):

@@ -51,7 +51,7 @@ def candidates(w: Weighing, opts: Options) -> tuple[list[E.Candidate], set[str]]
     kind in a model (a resonance, a Stribeck shape, a timing term) is kept as given
     (diagnosing an augmented model again)."""
     held = held_kinds(w.model.effects)
-    cands = [c for c in E.candidates() if c.effect not in held]
+    cands = [c for c in E.candidates(w.model.kind) if c.effect not in held]
     if opts.free_mass:
         cands = [c for c in cands if not isinstance(c, E.Mass)]
     if opts.candidates is not None:
@@ -85,17 +85,27 @@ def _refuse(w: Weighing, bs: BaseSet, cands: list[E.Candidate], opts: Options,
     refused: dict[str, dict[str, Any]] = {}
     checked = sorted((c for c in cands if type(c).check is not E.Candidate.check),
                      key=lambda c: c.check_rank)
-    for c in checked:
-        effect = c.effect
-        k = next((k for k, t in enumerate(terms) if t.effect == effect and not t.minor), None)
-        chk = None if k is None else terms[k].cand.check(bs.scorer, terms, k, ev, w.ctx)
-        why = None if chk is None else c.refusal(chk)
-        if chk is None or why is None:
-            continue
-        refused[effect] = chk
-        _not_named(log, effect, why)
-        terms, ev, log2 = run([c for c in cands if c.effect not in refused])
-        log += log2
+    # (after a refusal the search runs again and may name a term checked before: every
+    # check is read again until none refuses)
+    again = True
+    while again:
+        again = False
+        for c in checked:
+            effect = c.effect
+            k = next((k for k, t in enumerate(terms) if t.effect == effect and not t.minor),
+                     None)
+            if effect in refused or k is None:
+                continue
+            chk = terms[k].cand.check(bs.scorer, terms, k, ev, w.ctx)
+            why = None if chk is None else c.refusal(chk)
+            if chk is None or why is None:
+                continue
+            refused[effect] = chk
+            _not_named(log, effect, why)
+            terms, ev, log2 = run([c for c in cands if c.effect not in refused])
+            log += log2
+            again = True
+            break
     return terms, ev, log, refused
 
 

@@ -27,7 +27,8 @@ from ..vocabulary import (
     SPRING,
 )
 
-__all__ = ["EFFECTS", "axis_model", "case", "concealed", "reference_trajectory", "trajectory"]
+__all__ = ["EFFECTS", "axis_model", "case", "concealed", "reference_trajectory", "rotary_model",
+           "trajectory"]
 
 #: A default concealed instance of every effect of the vocabulary.
 EFFECTS: dict[str, dict[str, Any] | None] = {
@@ -163,6 +164,33 @@ def axis_model(seed: int) -> Model:
     })
 
 
+def rotary_model(seed: int) -> Model:
+    """A random rotary axis (a joint or a rotary table, joint side): inertia 0.005-2
+    kg m^2, torque constant 0.2-5 N m/A, Coulomb friction 2-8 % of the scale
+    ``20*inertia`` N m, static 1.3-2.2x Coulomb, Stribeck speeds 0.01-0.1 rad/s, a PID at
+    4-8 kHz with the bandwidth of the paper axis."""
+    rng = np.random.default_rng(seed + 9000)
+    j = float(np.exp(rng.uniform(np.log(0.005), np.log(2.0))))
+    kt = float(np.exp(rng.uniform(np.log(0.2), np.log(5.0))))
+    fc = 20.0 * j * rng.uniform(0.02, 0.08)
+    sets = {}
+    for side in ("positive", "negative"):
+        f = fc * (1 + 0.05 * rng.standard_normal())
+        sets[side] = {"fc": f, "fs": f * rng.uniform(1.3, 2.2),
+                      "sigma2": j * rng.uniform(4.0, 16.0),
+                      "vs": float(np.exp(rng.uniform(np.log(0.01), np.log(0.1))))}
+    s0 = 3.0 * max(sets["positive"]["fs"], sets["negative"]["fs"]) / 1e-3 * rng.uniform(0.5, 2)
+    g = j / 25.0
+    return Model({
+        "axis": {"kind": "rotary", "inertia": j, "torque_constant": kt},
+        "friction": {"model": "lugre", "sigma0": s0, "sigma1": 0.3 * np.sqrt(s0 * j) * 0.05,
+                     **sets},
+        "effects": [],
+        "controller": {"type": "pid", "kp": 5e4 * g, "ki": 5e5 * g, "kd": 1500.0 * g,
+                       "rate_hz": float(rng.choice([4000.0, 8000.0]))},
+    })
+
+
 def trajectory(kind: str, t: np.ndarray, seed: int = 0, stroke: float = 0.15) -> np.ndarray:
     """A position reference [m]: ``"sines"`` (smooth back and forth), ``"p2p"``
     (point-to-point moves with dwells, S-curve profiles) or ``"feeds"`` (constant-speed
@@ -200,16 +228,19 @@ def trajectory(kind: str, t: np.ndarray, seed: int = 0, stroke: float = 0.15) ->
 
 def case(truth_effects: list[dict[str, Any]], *, seed: int, axis_seed: int | None = None,
          kind: str = "sines", duration: float = 20.0, rate_hz: float = 1000.0,
-         current_noise: float = 0.01, quantum: float = 1e-6, base_error: float = 0.01
-         ) -> tuple[Recording, Recording, Model, Model]:
+         current_noise: float = 0.01, quantum: float = 1e-6, base_error: float = 0.01,
+         rotary: bool = False) -> tuple[Recording, Recording, Model, Model]:
     """A concealed case: recording and hold-out (another seed of the same trajectory
     kind), the believed model (base off by ``base_error``) and the truth.
 
-    ``axis_seed`` None: the paper axis; else :func:`axis_model`.
+    ``axis_seed`` None: the paper axis; else :func:`axis_model`, or with ``rotary``
+    :func:`rotary_model` (strokes of 0.3-1.5 rad, quantum and noise as given, in rad
+    and A).
     """
     truth = (Model.paper().replace(controller={"type": "pid", "kp": 5e4, "ki": 5e5,
                                                "kd": 1500.0, "rate_hz": 10000.0})
-             if axis_seed is None else axis_model(axis_seed))
+             if axis_seed is None else
+             rotary_model(axis_seed) if rotary else axis_model(axis_seed))
     truth = truth.replace(effects=[dict(e) for e in truth_effects])
     recs = []
     for s in (seed, seed + 1):
@@ -218,12 +249,14 @@ def case(truth_effects: list[dict[str, Any]], *, seed: int, axis_seed: int | Non
         over = max(1, round(rate / rate_hz))
         n = int(duration * rate_hz)
         tf = np.arange(n * over) / (rate_hz * over)
-        stroke = 0.15 if axis_seed is None else float(rng.uniform(0.05, 0.3))
+        stroke = (0.15 if axis_seed is None else float(rng.uniform(0.3, 1.5)) if rotary
+                  else float(rng.uniform(0.05, 0.3)))
         sf = simulate(truth, tf, trajectory(kind, tf, s, stroke), integrator="rk4")
         t = tf[::over]
         i = sf.i[::over] + current_noise * rng.standard_normal(t.size)
         x = np.round(sf.x[::over] / quantum) * quantum
-        recs.append(Recording(t=t, x=x, i=i, x_ref=trajectory(kind, t, s, stroke)))
+        recs.append(Recording(t=t, x=x, i=i, x_ref=trajectory(kind, t, s, stroke),
+                              meta={"axis_kind": truth.kind}))
     rng = np.random.default_rng(seed + 2000)
     b = truth.to_dict()
     b["effects"] = []

@@ -20,6 +20,12 @@ candidate                 signature (column)
                           held-out score of the joint fit over a grid (profile)
 ``delay``/``current_lag`` time derivative of the motor force (a lag against the command);
                           the two are told apart afterwards by their exact forms
+``gravity``               ``sin``/``cos`` of the angle (rotary axes only)
+``force_ripple``          the motor force times ``sin``/``cos`` of ``2*pi*x/pitch``
+``current_limit``         the change of the residual a clipped current makes (secant),
+                          over the percentiles of the current
+``load_friction``         the change of the residual that friction levels growing with
+                          the drive's force make (secant)
 ========================  =================================================================
 
 One module per family; :func:`candidates` lists them all.
@@ -29,18 +35,23 @@ from __future__ import annotations
 
 from .base import Candidate, Context, FindingView, Said, Term
 from .drift import Drift
+from .drive import CurrentLimit, ForceRipple, LoadFriction
 from .lag import Lag
 from .linear import Drag, Mass, Offset, Spring
-from .position import Cogging, PositionFriction
+from .position import Cogging, Gravity, PositionFriction
 from .resonance import Resonance
 from .secant import Deadband, StribeckShape
 
-__all__ = ["Candidate", "Cogging", "Context", "Deadband", "Drag", "Drift", "FindingView", "Lag",
-           "Mass", "Offset", "PositionFriction", "Resonance", "Said", "Spring", "StribeckShape",
-           "Term", "candidates"]
+__all__ = ["Candidate", "Cogging", "Context", "CurrentLimit", "Deadband", "Drag", "Drift",
+           "FindingView", "ForceRipple", "Gravity", "Lag", "LoadFriction", "Mass", "Offset",
+           "PositionFriction", "Resonance", "Said", "Spring", "StribeckShape", "Term",
+           "candidates"]
 
 
-def candidates() -> list[Candidate]:
-    """A fresh list of every candidate of the vocabulary."""
-    return [Offset(), Spring(), Mass(), Cogging(), PositionFriction(), Drift(), Lag(),
-            Drag(), StribeckShape(), Deadband(), Resonance()]
+def candidates(axis_kind: str = "linear") -> list[Candidate]:
+    """A fresh list of every candidate of the vocabulary that acts on a ``axis_kind``
+    axis (``gravity`` on a rotary one only: a linear axis's weight is an offset)."""
+    rotary = [Gravity()] if axis_kind == "rotary" else []
+    return [Offset(), Spring(), *rotary, Mass(), Cogging(), PositionFriction(), Drift(),
+            Lag(), Drag(), StribeckShape(), Deadband(), Resonance(), ForceRipple(),
+            CurrentLimit(), LoadFriction()]

@@ -165,6 +165,12 @@ class Candidate:
     #: its coefficients scale the friction levels: the joint refit keeps their median
     #: in the base levels (:func:`lugre.diagnosis.refit.refine`)
     scales_levels: bool = False
+    #: the least force it must add to be named, in units of the search's practical size
+    #: (0.3 % of the motor force), and why when more than one
+    least_force: float = 1.0
+    least_force_why: str = ""
+    #: too small to name but consistent, it may enter the fit as a minor correction
+    may_be_minor: bool = True
     #: a small correction nearly consistent over the blocks enters the fit as minor,
     #: never named (a mass error left out leaks into whatever follows the force)
     minor_when_consistent: bool = False

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 
 from ... import units as U
-from ...vocabulary import DRAG, MASS, OFFSET, SPRING
+from ...vocabulary import DRAG, LOAD_FRICTION, MASS, OFFSET, SPRING
 from .. import base as B
 from .. import residual as R
 from .base import Candidate, Context, FindingView, Said, by
@@ -292,7 +292,6 @@ def mass_alternative(delta: float, mass: float, sig: R.Signals,
     brake = float(np.mean((sig.fm_f * sig.vf)[m] < 0)) if m.any() else 0.0
     if brake >= 0.05 or delta <= 0:
         return None
-    return {"effect": U.words("friction growing with the drive force (outside the "
-                              "vocabulary)"),
-            "parameters": {"mu": float(delta / mass), "braking_share": brake},
+    return {"effect": LOAD_FRICTION,
+            "parameters": {"coefficient": float(delta / mass), "braking_share": brake},
             "experiment": U.words(FORCE_FRICTION_EXPERIMENT)}

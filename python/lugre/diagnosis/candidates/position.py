@@ -8,12 +8,50 @@ from typing import Any
 import numpy as np
 
 from ... import units as U
-from ...vocabulary import COGGING, POSITION_FRICTION
+from ...vocabulary import COGGING, GRAVITY, OFFSET, POSITION_FRICTION
 from ..residual import position_sums
 from .base import Candidate, Context, by
 from .probe import hide, share, under
 
-__all__ = ["Cogging", "PositionFriction"]
+__all__ = ["Cogging", "Gravity", "PositionFriction"]
+
+
+class Gravity(Candidate):
+    """A load's weight on a joint, ``torque*sin(x + phase)``: two columns, ``sin(x)``
+    and ``cos(x)``. One turn is known, so a record that spans a fraction of a turn still
+    shows the curvature that tells it from a spring and an offset (which it contains)."""
+
+    effect = GRAVITY
+    supersedes = (OFFSET,)
+    signature = ("a torque following the sine of the joint angle, the same in both "
+                 "directions of motion and at rest (a load's weight)")
+
+    def columns(self, h: Any, ctx: Context) -> np.ndarray:
+        x = ctx.sig.x
+        return ctx.sig.filt(np.column_stack([np.sin(x), np.cos(x)]))
+
+    def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
+        torque = float(math.hypot(beta[0], beta[1]))
+        phase = float(math.atan2(beta[1], beta[0]))
+        return [{"effect": GRAVITY, "torque": torque, "phase": phase}]
+
+    def where(self, h: Any, beta: np.ndarray, ctx: Context) -> dict[str, Any]:
+        return {"position": list(ctx.xrange), "time": None, "velocity": None}
+
+    figure = by("x", "position [m]")
+
+    def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
+        torque = float(math.hypot(beta[0], beta[1]))
+        level = -float(math.atan2(beta[1], beta[0]))
+        return (f"At most {U.fmt(torque, 'N')}; it vanishes where the load hangs level "
+                f"with the joint, at {U.fmt(level, 'm')} of the axis's zero.")
+
+    def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
+        x = ctx.sig.x
+        xm = 0.5 * (ctx.xrange[0] + ctx.xrange[1])
+        b = float(np.max(sizes([ctx.sig.filt(np.sin(x - xm)), ctx.sig.filt(np.cos(x - xm))])))
+        return hide(self.effect, b, "N", f"a gravity torque {under(b, '{:.2g} N m')}",
+                    experiment="slow moves over a large part of a turn in both directions")
 
 
 class Cogging(Candidate):

@@ -1,0 +1,289 @@
+"""Effects of the drive's force path: a force (torque) ripple that scales with the
+current, an amplifier that saturates, and friction that grows with the force the
+transmission carries."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ... import units as U
+from ...vocabulary import COGGING, CURRENT_LIMIT, FORCE_RIPPLE, LOAD_FRICTION
+from ..residual import position_sums
+from .base import Candidate, Context, by
+from .linear import mass_both_ways
+from .position import Cogging
+from .probe import amps, hide, refit_on, share, start_of, under
+from .secant import _Secant
+
+__all__ = ["BRAKING_SHARE", "CurrentLimit", "ForceRipple", "LoadFriction"]
+
+#: Least share of the samples where the drive brakes the axis for a friction growing
+#: with the drive's force to be told from a payload (as :func:`mass_alternative`).
+BRAKING_SHARE = 0.05
+
+
+class ForceRipple(Candidate):
+    """``K_F*i*(1 + a*sin(2*pi*x/p + phase))``: the columns are the motor force times
+    ``sin`` and ``cos`` of ``2*pi*x/p``, the pitch from the periodogram of the residual
+    weighted by the motor force. A cogging is the same periodic force at any current; a
+    ripple vanishes with the current and changes sign with it."""
+
+    effect = FORCE_RIPPLE
+    chooses = True
+    #: 1 % of the motor force: a ripple under it matters little to a loop, and what a
+    #: lag's misfit leaves along a stroke read as 0.1 % ripple on a clean feed record
+    least_force = 10.0 / 3.0
+    least_force_why = "a ripple this small is within what other misfits leave along the stroke"
+    signature = ("a force periodic in position that grows with the motor current and "
+                 "changes sign with it (force-constant or torque ripple)")
+
+    def choose(self, r: np.ndarray, ctx: Context) -> Any:
+        ks = Cogging()._kgrid(ctx)
+        if ks.size == 0:
+            return None
+        m = ctx.sig.mask
+        step = max(1, int(m.sum() // 6000))
+        x = ctx.sig.x[m][::step]
+        fm = ctx.sig.fm_f[m][::step]
+        w = fm * (r[m][::step] - np.mean(r[m]))
+        span = max(ctx.xrange[1] - ctx.xrange[0], 1e-9)
+        p = _power(ctx, x, w, float(ks[0]), 0.25 / span, ks.size)
+        k0 = float(ks[int(np.argmax(p))])
+        lo, hi = k0 - 0.3 / span, k0 + 0.3 / span
+        pf = _power(ctx, x, w, lo, (hi - lo) / 30, 31)
+        return 1.0 / float(np.linspace(lo, hi, 31)[int(np.argmax(pf))])
+
+    def columns(self, h: Any, ctx: Context) -> np.ndarray:
+        ph = 2.0 * np.pi * ctx.sig.x / h
+        fm = ctx.sig.fm
+        return ctx.sig.filt(np.column_stack([fm * np.sin(ph), fm * np.cos(ph)]))
+
+    def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
+        # the residual is K_F*i - (model force): a ripple adds K_F*i*a*sin(...) to what
+        # acts, so the residual of the model without it holds -K_F*i*a*sin(...)
+        amp = float(math.hypot(beta[0], beta[1]))
+        phase = float(math.atan2(-beta[1], -beta[0]))
+        return [{"effect": FORCE_RIPPLE, "amplitude": min(amp, 0.95), "pitch": float(h),
+                 "phase": phase}]
+
+    def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
+        pitch = U.fmt(float(h), "m")
+        return (f"The residual weighted by the motor {U.force_words()} peaks at a pitch of "
+                f"{pitch}: the periodic part grows with the current (unlike a cogging).")
+
+    figure = by("x", "position [m]")
+
+    def where(self, h: Any, beta: np.ndarray, ctx: Context) -> dict[str, Any]:
+        return {"position": list(ctx.xrange), "time": None, "velocity": None}
+
+    def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
+        sig = ctx.sig
+        span = max(ctx.xrange[1] - ctx.xrange[0], 1e-9)
+        ks = np.geomspace(1.5 / span, max(Cogging.kmax(ctx), 2.0 / span), 6)
+        amps_ = sizes([sig.filt(sig.fm * np.sin(2 * np.pi * k * sig.x)) for k in ks])
+        seen = np.isfinite(amps_)
+        b = share(float(np.max(amps_[seen]))) if seen.any() else math.inf
+        return hide(self.effect, b, "-", f"a {U.force_words()} ripple "
+                    f"{under(100 * b, '{:.2g} %')} of the motor {U.force_words()}",
+                    experiment=("slow constant-speed passes under a steady load (a "
+                                "current well away from zero) show the ripple apart from "
+                                "a cogging"))
+
+
+def _power(ctx: Context, x: np.ndarray, w: np.ndarray, k0: float, dk: float,
+           n: int) -> np.ndarray:
+    """Power of the sinusoids of ``w`` over ``x`` at ``k0 + j*dk`` (their sums; the
+    weights of the ripple's columns taken as even over a period)."""
+    s, c = position_sums(ctx.sig, x, w, k0, dk, n)
+    return np.asarray(s) ** 2 + np.asarray(c) ** 2
+
+
+class CurrentLimit(_Secant):
+    """``K_F*clip(i, -c, c)``: the record holds the command, the axis gets less above
+    the limit. Searched over the percentiles of the recorded current (a saturated
+    drive's integrator keeps the command above the limit for long), then on a finer
+    grid around the best; a record that never reaches a limit cannot show one."""
+
+    effect = CURRENT_LIMIT
+    param = "current"
+    #: a clip of the few highest currents is what a lag or a resonance does to the
+    #: peaks too: kept as a minor correction it took a current lag's place
+    may_be_minor = False
+    #: 1 % of the motor force: a clip of the peaks under it is what a mass error, a lag
+    #: or a resonance leaves at the peaks of the current as well
+    least_force = 10.0 / 3.0
+    least_force_why = "a clip of the peaks this small is what other misfits leave there"
+    signature = ("the drive's force stops growing above a current: the logged command "
+                 "asks for more than acts at the peaks of the current")
+
+    def grid(self, ctx: Context) -> np.ndarray | None:
+        ia = np.abs(ctx.sig.fm[ctx.sig.mask]) / ctx.model.force_constant
+        if ia.size == 0 or not float(np.max(ia)) > 0:
+            return None
+        return np.percentile(ia, [20.0, 35.0, 50.0, 65.0, 75.0, 85.0, 92.0, 96.0, 98.5, 99.5])
+
+    def effect_at(self, h: Any) -> dict[str, Any]:
+        return {"effect": CURRENT_LIMIT, "current": float(h)}
+
+    check_rank = 2
+
+    def check(self, scorer: Any, terms: list[Any], k: int, ev: Any, ctx: Context
+              ) -> dict[str, Any] | None:
+        return clip_both_ways(scorer, terms, k, ev, ctx)
+
+    def refusal(self, chk: dict[str, Any]) -> str | None:
+        if not chk["not_limit"]:
+            return None
+        return (f"it reads {chk['rising']:+.2g} while the current rises toward its peaks "
+                f"and {chk['falling']:+.2g} while it falls: a limit clips both alike, a "
+                "force that lags the current does not")
+
+    def from_secant(self, h: Any, b: float) -> Any:
+        # the clipped excess is far from linear in the limit: the limit is the grid
+        # point's, found by the held-out profile (coarse, then fine)
+        return float(h)
+
+    def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
+        c = self.from_secant(h, float(beta[0]))
+        return (f"Above {amps(c)} ({c * ctx.model.force_constant:.3g} "
+                f"{U.si('N')}) the drive gives no more {U.force_words()}.")
+
+    def figure(self, residual: np.ndarray, contrib: np.ndarray, ctx: Context
+               ) -> dict[str, Any]:
+        m = ctx.sig.mask
+        i = ctx.sig.fm_f[m] / ctx.model.force_constant
+        o = np.argsort(i, kind="stable")
+        return {"x": i[o], "xlabel": "current [A]", "residual": residual[m][o],
+                "effect": contrib[m][o]}
+
+    def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
+        ia = np.abs(ctx.sig.fm[ctx.sig.mask]) / ctx.model.force_constant
+        top = float(np.max(ia)) if ia.size else 0.0
+        return hide(self.effect, math.inf, "A",
+                    f"a current limit above {amps(top)} (the largest current of this "
+                    "record; a limit it never reached is not determined)",
+                    experiment="moves that ask for the drive's peak current")
+
+
+def _payload_does_as_well(scorer: Any, terms: list[Any], k: int, ev: Any,
+                          ctx: Any) -> bool:
+    """Whether a payload in place of the load-friction term ``terms[k]`` gains at least
+    four fifths of what the term gains on the held-out stretches (a friction growing
+    with the drive's force on constant-speed feeds scales the levels, no payload)."""
+    from .base import Term
+    from .linear import Mass
+
+    others = terms[:k] + terms[k + 1:]
+    mass = Term(cand=Mass(), h=None, X=Mass().columns(None, ctx))
+    none = scorer.evaluate(others).score
+    return bool(none - scorer.evaluate(others + [mass]).score >= 0.8 * (none - ev.score))
+
+
+def clip_both_ways(scorer: Any, terms: list[Any], k: int, ev: Any,
+                   ctx: Any) -> dict[str, Any] | None:
+    """Is the current-limit term ``terms[k]`` a limit, the same while the current rises
+    toward its peaks and while it falls? A clip takes ``|i| - c`` away wherever the
+    current is over the limit, either way; a force lagging the current is short of it
+    while the current rises and beyond it while it falls, which a clip of the peaks
+    partly resembles. The term is refitted, jointly with the base and the other terms,
+    on the samples over the limit where ``|i|`` rises and on those where it falls; when
+    both determine it (standard errors under a quarter of the full fit's) and they
+    differ by more than four combined standard errors and by more than half the full
+    fit, the term is no limit. Returns the figures, or None when the record cannot tell.
+    """
+    sig = ctx.sig
+    m = scorer.mask
+    over = m & (np.abs(terms[k].X[:, 0]) > 0.05 * float(np.max(np.abs(terms[k].X[m, 0]))))
+    rate = np.gradient(np.abs(sig.fm_f))
+    rising, falling = over & (rate > 0), over & (rate < 0)
+    if min(rising.sum(), falling.sum()) < 20:
+        return None
+    full = float(ev.beta[start_of(scorer, terms, k)])
+    out: dict[str, Any] = {"coefficient": full}
+    for name, sel in (("rising", rising), ("falling", falling)):
+        fit = refit_on(scorer, terms, k, sel)
+        if fit is None:
+            return None
+        out[name], out[name + "_se"] = fit
+    a, b = out["rising"], out["falling"]
+    se = float(np.hypot(out["rising_se"], out["falling_se"]))
+    out["not_limit"] = bool(max(out["rising_se"], out["falling_se"]) < 0.25 * abs(full)
+                            and abs(a - b) > 4.0 * se and abs(a - b) > 0.5 * abs(full))
+    return out
+
+
+class LoadFriction(_Secant):
+    """Friction levels that grow with the force the transmission carries,
+    ``fc + c*|K_F*i|``: searched as the change of the residual that a coefficient
+    makes (the bristle state included), over a grid of coefficients."""
+
+    effect = LOAD_FRICTION
+    param = "coefficient"
+    scales_levels = False
+    #: 1 % of the motor force: below, its column is what a mass off by a percent and
+    #: the plant's own discretisation leave (clean records of an independent plant read
+    #: 0.4-0.8 % with a believed mass 1 % off; 2 % load friction reads 1.8 %)
+    least_force = 10.0 / 3.0
+    least_force_why = ("a friction growing with the drive's force this small is what a "
+                       "mass off by a percent leaves")
+    signature = ("friction that grows with the drive's force: more friction where the "
+                 "axis is accelerated or loaded, in the direction of motion")
+
+    def grid(self, ctx: Context) -> np.ndarray | None:
+        return np.array([0.01, 0.03, 0.1, 0.3])
+
+    check_rank = 1
+
+    def check(self, scorer: Any, terms: list[Any], k: int, ev: Any, ctx: Context
+              ) -> dict[str, Any] | None:
+        # where the drive (almost) never brakes the axis, |F| against the motion is F:
+        # a payload beside friction levels that much higher, the simpler story, which
+        # the mass's finding tells with this as its look-alike
+        sig, m = ctx.sig, scorer.mask
+        brake = float(np.mean((sig.fm_f * sig.vf)[m] < 0)) if m.any() else 0.0
+        if brake < BRAKING_SHARE and _payload_does_as_well(scorer, terms, k, ev, ctx):
+            return {"braking_share": brake, "like_payload": True, "not_payload": False}
+        # the same refit on the samples where the drive speeds the axis up and where
+        # it brakes it: a friction growing with the drive's force reads the same
+        # coefficient on both, a payload (or a level error) does not
+        return mass_both_ways(scorer, terms, k, ev, ctx)
+
+    def refusal(self, chk: dict[str, Any]) -> str | None:
+        if chk.get("like_payload"):
+            return (f"the drive brakes the axis on {100 * chk['braking_share']:.1f} % of "
+                    "the samples only: a friction growing with its force cannot be told "
+                    f"from a payload beside higher friction levels, and the payload (one "
+                    "parameter) is told, with this as its look-alike")
+        if not chk["not_payload"]:
+            return None
+        return (f"the coefficient reads {chk['speeding_up']:+.2g} where the drive speeds "
+                f"the axis up and {chk['braking']:+.2g} where it brakes: a friction "
+                "growing with the drive's force is the same both ways")
+
+    def effect_at(self, h: Any) -> dict[str, Any]:
+        return {"effect": LOAD_FRICTION, "coefficient": float(h)}
+
+    def from_secant(self, h: Any, b: float) -> Any:
+        return float(max(b * float(h), 0.0))
+
+    figure = by("v", "velocity [m/s]")
+
+    def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
+        c = self.from_secant(h, float(beta[0]))
+        return (f"The friction levels grow by {100 * c:.2g} % of the drive's "
+                f"{U.force_words()}.")
+
+    def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
+        h0 = 0.05
+        b = h0 * float(sizes([self.columns(h0, ctx)[:, 0]])[0])
+        return hide(self.effect, b, "-", "a friction growing with the drive's "
+                    f"{U.force_words()} {under(100 * b, '{:.2g} %')} of it",
+                    experiment=("moves at one speed under different loads or "
+                                "accelerations"))
+
+
+#: The cogging's look-alike among these: told apart by how it scales with the current.
+LOOKALIKES = {FORCE_RIPPLE: COGGING}
