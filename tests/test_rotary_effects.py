@@ -74,3 +74,22 @@ def test_a_clean_joint_against_its_own_fit_names_nothing(seed, kind):
     assert fitted.is_rotary and fitted.mass == pytest.approx(truth.mass, rel=0.05)
     dg = diagnose(rec, fitted, holdout=hold)
     assert dg.findings == [], dg.summary()
+
+
+def test_the_fit_sets_a_joints_gravity_aside_and_the_diagnosis_names_it():
+    """A gravity-loaded joint fitted by the user: the weight's torque is fitted beside
+    the base (so friction levels and inertia stay the joint's), left out of the model
+    and said; diagnosing against that fit names it with its torque and phase."""
+    seed = 11
+    ax = rotary_model(seed)
+    g = {"effect": "gravity", "torque": 2.0 * ax.positive["fc"], "phase": 0.4}
+    rec, hold, _, truth = _joint([g], seed, "sines")
+    fitted, fit = fit_model(rec, force_constant=truth.force_constant)
+    assert not fitted.effects and [e["effect"] for e in fit.set_aside] == ["gravity"]
+    assert fitted.mass == pytest.approx(truth.mass, rel=0.05)
+    assert fitted.positive["fc"] == pytest.approx(truth.positive["fc"], rel=0.1)
+    dg = diagnose(rec, fitted, holdout=hold)
+    assert [f.effect for f in dg.findings] == ["gravity"], dg.summary()
+    assert dg.findings[0].parameters["torque"] == pytest.approx(g["torque"], rel=0.15)
+    kept, _ = fit_model(rec, force_constant=truth.force_constant, effects=["gravity"])
+    assert [e["effect"] for e in kept.effects] == ["gravity"]

@@ -471,6 +471,14 @@ def _print_fit(fit: Any, effects: list[str]) -> None:
                   "stretches); left out of the model", file=sys.stderr)
     for note in undetermined_notes(fit):
         print(f"note: {note}")
+    from . import units as U
+
+    for e in fit.set_aside:
+        print(f"note: a {U.force_words()} following the angle, {e['torque']:.4g} "
+              f"{U.si('N')} at a phase of {e['phase']:.3g} rad (gravity), was fitted beside "
+              "the base and is left out of the model: lugre diagnose names it with its "
+              "evidence and its augmented model holds it (lugre fit --effects gravity "
+              "keeps it in)")
 
 
 def _cmd_paper(args: argparse.Namespace) -> int:

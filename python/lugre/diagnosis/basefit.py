@@ -75,6 +75,9 @@ class BaseFitResult:
     diagnosis: Any = None
     #: ``J^T W J`` of the fit in the parameters themselves (for the intervals)
     information: Any = field(default=None, repr=False)
+    #: effects fitted beside the base and left out of ``model`` (a joint's gravity,
+    #: which the diagnosis names): said by the fit's report
+    set_aside: tuple[dict[str, Any], ...] = ()
 
     @property
     def floor_ratio(self) -> float:

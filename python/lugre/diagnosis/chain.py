@@ -9,7 +9,7 @@ from typing import Any
 
 from ..exceptions import InputError
 from ..model import Model
-from ..vocabulary import NAMES, kind
+from ..vocabulary import GRAVITY, NAMES, kind
 from . import residual as R
 from .basefit import fit_base, identify
 from .core import diagnose
@@ -76,6 +76,11 @@ def fit_model(
     rec = as_recording(recording)
     res = identify(rec, mass=mass, force_constant=force_constant, cutoff_hz=cutoff_hz,
                    backend=backend)
+    if GRAVITY in wanted:  # (the fit holds it already when the record shows one)
+        held = any(e["effect"] == GRAVITY for e in res.model.effects)
+        wanted = [e for e in wanted if e != GRAVITY or not held]
+    else:
+        res = _gravity_set_aside(res)
     if not wanted:
         return res.model, res
     dg = diagnose(rec, res.model, candidates=wanted, free_mass=mass is None,
@@ -95,3 +100,14 @@ def fit_model(
         warnings.simplefilter("ignore")
         final = fit_base(sig, model, free_mass=mass is None)  # (model: the first start)
     return final.model, replace(final, diagnosis=dg)
+
+
+def _gravity_set_aside(res: Any) -> Any:
+    """The fit without the gravity its linear start took up beside the base (a joint's
+    load, which friction levels and the mass would otherwise absorb), unless asked for:
+    ``lugre diagnose`` names it with its evidence and the augmented model holds it."""
+    grav = [e for e in res.model.effects if e["effect"] == GRAVITY]
+    if not grav:
+        return res
+    rest = [e for e in res.model.effects if e["effect"] != GRAVITY]
+    return replace(res, model=res.model.replace(effects=rest), set_aside=tuple(grav))

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..exceptions import DataError
 from ..model import Model, axis_document
+from ..vocabulary import GRAVITY
 from . import residual as R
 from .evaluation import as_recording
 from .options import IDENTIFY_TOLERANCE
@@ -107,6 +108,17 @@ def fit_inverse_dynamics(
     # robust (IGG-weighted IRLS) fit of the base and of each candidate, the best kept:
     # the core's estimate::irls_linear_grid or its NumPy twin
     found = R.kernels(sig.backend).irls_linear_grid(X, extras, y[m])
+    # a joint's load: gravity's sin and cos of the angle beside the base, kept when
+    # they take a fifth or more off the robust scale (friction levels and the mass
+    # would otherwise take up the weight's torque)
+    grav = _gravity_columns(sig) if kind == "rotary" else None
+    ng = 0
+    if grav is not None:
+        with_g = R.kernels(sig.backend).irls_linear_grid(
+            np.column_stack([X, grav[m]]), extras, y[m])
+        physical = _plausible(with_g.fit.coef, 0 if mass is not None else 1)
+        if physical and with_g.fit.scale < (1.0 - GRAVITY_GAIN) * found.fit.scale:
+            found, ng = with_g, 2
     vs = float(grid[found.chosen]) if found.chosen is not None else None
     b = found.fit.coef
     off = 0 if mass is not None else 1
@@ -116,8 +128,8 @@ def fit_inverse_dynamics(
                         f"{'kg m^2' if kind == 'rotary' else 'kg'}: the record does not "
                         "excite the inertia; give the mass (--mass)")
     fcp, s2p, fcn, s2n = (float(b[off + k]) for k in range(4))
-    dp = float(b[off + 4]) if vs is not None else 0.0
-    dn = float(b[off + 5]) if vs is not None else 0.0
+    dp = float(b[off + 4 + ng]) if vs is not None else 0.0
+    dn = float(b[off + 5 + ng]) if vs is not None else 0.0
     vs_val = float(vs) if vs is not None else 0.05 * max(vmax, 1e-6)
     fcp, fcn = max(fcp, 1e-3), max(fcn, 1e-3)
     fsmax = max(fcp + dp, fcn + dn)
@@ -134,10 +146,37 @@ def fit_inverse_dynamics(
             "negative": {"fc": fcn, "fs": fcn + max(dn, 0.0), "sigma2": max(s2n, 0.0),
                          "vs": vs_val},
         },
-        "effects": [],
+        "effects": [] if not ng else [_gravity_effect(b[off + 4], b[off + 5])],
     }
     if controller is not None:
         doc["controller"] = controller
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return Model(doc)
+
+
+#: Least share of the robust scale that gravity's columns must take off to be kept.
+GRAVITY_GAIN = 0.2
+
+
+def _plausible(b: np.ndarray, off: int) -> bool:
+    """Whether a linear start with gravity is an axis: a positive mass (when fitted)
+    and Coulomb levels of both directions positive and within a factor of three of
+    each other (over a fraction of a turn with few reversals, sin and cos of the angle
+    can stand in for the levels' difference, and a base axis read 1.1e4 N m of
+    "gravity" with levels of 0 and 1e4 N m)."""
+    fcp, fcn = float(b[off]), float(b[off + 2])
+    if off and not b[0] > 0:
+        return False
+    return fcp > 0 and fcn > 0 and max(fcp, fcn) < 3.0 * min(fcp, fcn)
+
+
+def _gravity_columns(sig: Any) -> np.ndarray:
+    """Filtered ``sin(x)`` and ``cos(x)``: a load's weight on a joint."""
+    return np.column_stack([sig.filt(np.sin(sig.x)), sig.filt(np.cos(sig.x))])
+
+
+def _gravity_effect(bs: float, bc: float) -> dict[str, Any]:
+    """The ``gravity`` effect of the coefficients of ``sin(x)`` and ``cos(x)``."""
+    return {"effect": GRAVITY, "torque": float(math.hypot(bs, bc)),
+            "phase": float(math.atan2(bc, bs))}

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from .. import units as U
-from ..exceptions import LugreError
+from ..exceptions import DataError, LugreError
 from .candidates import Candidate, Context, Term
 from .scoring import (
     _ONE_BLOCK,
@@ -210,7 +210,16 @@ class _Trial:
 def _try(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidate, ctx: Context,
          rules: _Rules, step: int) -> _Trial | None:
     """Candidate ``c`` beside ``terms``, judged by the rules; None when the record
-    cannot carry it."""
+    cannot carry it (its columns cannot be computed: a load behind a coupling that
+    diverges along this motion under this base)."""
+    try:
+        return _try_columns(scorer, terms, cur, c, ctx, rules, step)
+    except DataError:
+        return None
+
+
+def _try_columns(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidate,
+                 ctx: Context, rules: _Rules, step: int) -> _Trial | None:
     kept = [t for t in terms if t.effect not in c.supersedes]
     grid = c.grid(ctx)
     if grid is None and getattr(c, "needs_grid", False):
