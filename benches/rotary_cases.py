@@ -14,7 +14,8 @@ inertia that varies with the angle, as a joint's does with the arm behind it).
 
 Sizes (public; concealed halves them): gravity 2 fc of torque, load friction 0.1,
 force ripple 5 % at a pitch of 0.3 rad, a current limit clipping the top 6 % of the
-current the axis asks for without it (concealed: the top 3 %).
+current the axis asks for without it (concealed: the top 3 %; 0.5 % where the PID, which
+has no anti-windup, would run away against it).
 """
 
 from __future__ import annotations
@@ -46,10 +47,23 @@ def effect(name: str, seed: int, kind: str, scale: float) -> dict:
         return {"effect": "force_ripple", "amplitude": 0.05 * scale, "pitch": 0.3,
                 "phase": 0.9}
     if name == "current_limit":
-        rec, _, _, _ = case([], seed=seed, axis_seed=seed, kind=kind, **_REC)
-        top = float(np.percentile(np.abs(rec.i), 100.0 - 6.0 * scale))
-        return {"effect": "current_limit", "current": top}
+        return _limit(seed, kind, scale)
     raise ValueError(name)
+
+
+def _limit(seed: int, kind: str, scale: float) -> dict:
+    """A current limit clipping the top ``6*scale`` % of the current the axis asks for
+    without it, raised (to 99.5 %) when the PID, which has no anti-windup, runs away
+    against it: a drive would not be run so."""
+    rec, _, _, _ = case([], seed=seed, axis_seed=seed, kind=kind, **_REC)
+    top = float(np.max(np.abs(rec.i)))
+    for share in (6.0 * scale, 0.5):
+        lim = {"effect": "current_limit",
+               "current": float(np.percentile(np.abs(rec.i), 100.0 - share))}
+        clipped, _, _, _ = case([lim], seed=seed, axis_seed=seed, kind=kind, **_REC)
+        if float(np.max(np.abs(clipped.i))) < 3.0 * top:
+            break
+    return lim
 
 
 def varying_inertia(out: Path, name: str, seed: int, kind: str) -> None:

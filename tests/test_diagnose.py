@@ -942,3 +942,21 @@ def test_a_record_that_barely_moves_back_is_refused_with_its_counts():
         lugre.fit_model(rec, force_constant=25.0)
     with pytest.raises(DataError, match="record a move back"):
         diagnose(rec, lugre.Model.paper())
+
+
+def test_a_candidate_the_base_cannot_simulate_is_skipped_not_fatal():
+    """A fitted base with a bristle stiffness the record does not determine (a
+    gravity-dominated joint's fit gave 1e12 N m/rad; here 1e18 N/m at 250 Hz) needs more
+    substeps a sample than the load simulation behind a resonance takes: that candidate
+    is skipped, the diagnosis runs."""
+    from lugre.diagnosis.synth import case
+
+    rec, _hold, believed, _ = case([], seed=31, kind="sines", duration=10.0, rate_hz=250.0)
+    stiff = believed.with_friction(sigma0=1e18)
+    with pytest.raises(lugre.ParameterError):
+        lugre.load_coupling(rec.x, np.gradient(rec.x, rec.t), float(rec.t[1] - rec.t[0]),
+                            stiff.replace(effects=[{"effect": "resonance", "frequency": 30.0,
+                                                    "damping_ratio": 0.05,
+                                                    "load_fraction": 0.5}]))
+    dg = diagnose(rec, stiff, closed_loop=False)  # (raised that ParameterError before)
+    assert "resonance" not in [f.effect for f in dg.findings]

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from .. import units as U
-from ..exceptions import DataError, LugreError
+from ..exceptions import DataError, LugreError, ParameterError
 from .candidates import Candidate, Context, Term
 from .scoring import (
     _ONE_BLOCK,
@@ -211,10 +211,11 @@ def _try(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidate, ctx: 
          rules: _Rules, step: int) -> _Trial | None:
     """Candidate ``c`` beside ``terms``, judged by the rules; None when the record
     cannot carry it (its columns cannot be computed: a load behind a coupling that
-    diverges along this motion under this base)."""
+    diverges along this motion under this base, or one whose stiff bristles would need
+    more substeps a sample than the load simulation takes)."""
     try:
         return _try_columns(scorer, terms, cur, c, ctx, rules, step)
-    except DataError:
+    except (DataError, ParameterError):
         return None
 
 
