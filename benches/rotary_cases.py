@@ -6,7 +6,8 @@
 
 Random rotary axes (:func:`lugre.diagnosis.synth.rotary_model`: inertia 0.005-2 kg m^2,
 torque constant 0.2-5 N m/A, PID at 4-8 kHz), sines, point-to-point moves and feeds of
-0.3-1.5 rad, 1 kHz, a 1e-5 rad encoder, 5 mA of current noise. ``public``: the four
+0.3-1.5 rad, 1 kHz, a 1e-5 rad encoder, current noise of 1 % of the static friction's
+current. ``public``: the four
 drive effects (gravity, load friction, force ripple, current limit) at full size, a
 few seeds; ``concealed``: the same at half the size, on fresh axes and seeds drawn from
 ``--seed``, plus ``--clean`` clean records and a case outside the vocabulary (an
@@ -26,13 +27,24 @@ from pathlib import Path
 
 import numpy as np
 from lugre import Recording
-from lugre.diagnosis.synth import case, rotary_model
+from lugre.diagnosis.synth import case as synth_case
+from lugre.diagnosis.synth import rotary_model
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from concealed_cases import save_case
 
 KINDS = ("sines", "p2p", "feeds")
-_REC = {"rotary": True, "quantum": 1e-5, "current_noise": 0.005, "duration": 20.0}
+_REC = {"rotary": True, "quantum": 1e-5, "duration": 20.0}
+
+
+def case(effects: list[dict], *, seed: int, axis_seed: int, kind: str, **kw):
+    """:func:`lugre.diagnosis.synth.case` on the rotary axis ``axis_seed`` with current
+    noise of 1 % of its static friction's current (a fixed 5 mA was up to twice the
+    friction's current on a light joint with a large torque constant)."""
+    ax = rotary_model(axis_seed)
+    noise = 0.01 * max(ax.positive["fs"], ax.negative["fs"]) / ax.force_constant
+    return synth_case(effects, seed=seed, axis_seed=axis_seed, kind=kind,
+                      current_noise=noise, **kw)
 
 
 def effect(name: str, seed: int, kind: str, scale: float) -> dict:
