@@ -2,7 +2,9 @@
 finding: the base a ``lugre fit`` identified is re-estimated freely (its mass among
 its parameters), and a moved mass would otherwise pass as a base move. Across two
 records of one axis that is a payload or, on a joint, another configuration of the
-arm behind it: a change to name, with its size and its unit."""
+arm behind it: a change to name, with its size and its unit. Only when the record,
+identified alone, also puts the mass there: on the record the model was fitted on, a
+mass that moves is what the findings took back from it (a spring in the mass)."""
 
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from ..model import Model
 from ..vocabulary import MASS
 from . import evidence as V
 from . import residual as R
+from .basefit import identify
 from .report import Diagnosis, Finding
 
 __all__ = ["MASS_CHANGE_SHARE", "MASS_CHANGE_WIDTHS", "name_mass_change"]
@@ -36,7 +39,14 @@ def name_mass_change(dg: Diagnosis, given: Model, rec: Any, *, cutoff_hz: float 
     if None in interval or any(f.effect == MASS for f in dg.findings):
         return dg
     half = 0.5 * (float(interval[1]) - float(interval[0]))
-    if abs(delta) <= max(MASS_CHANGE_WIDTHS * half, MASS_CHANGE_SHARE * given.mass):
+    within = max(MASS_CHANGE_WIDTHS * half, MASS_CHANGE_SHARE * given.mass)
+    if abs(delta) <= within:
+        return dg
+    # the record identified alone, as lugre fit would: a mass where the model's is means
+    # the move is the findings' (a spring the fit had taken into the mass), not the axis's
+    own = identify(rec, force_constant=given.force_constant, cutoff_hz=cutoff_hz,
+                   backend=backend, profiles=False).model.mass
+    if abs(own - given.mass) <= within:
         return dg
     explained = _explained(rec, given, new, cutoff_hz, backend)  # (new: a total mass)
     u = U.si("kg")
