@@ -93,3 +93,23 @@ def test_the_fit_sets_a_joints_gravity_aside_and_the_diagnosis_names_it():
     assert dg.findings[0].parameters["torque"] == pytest.approx(g["torque"], rel=0.15)
     kept, _ = fit_model(rec, force_constant=truth.force_constant, effects=["gravity"])
     assert [e["effect"] for e in kept.effects] == ["gravity"]
+
+
+def test_a_rotary_axis_writes_its_mass_effect_as_inertia(tmp_path):
+    """CONTRACT: the mass effect of a rotary axis is written ``inertia`` (and ``mass``
+    is read as the same): in the model file and in the report, with its unit on the
+    page."""
+    from lugre.html import diagnosis_page
+
+    seed = 32
+    payload = {"effect": "mass", "delta": 0.3 * rotary_model(seed).mass}
+    rec, hold, believed, _ = _joint([payload], seed, "p2p")
+    dg = diagnose(rec, believed, holdout=hold)
+    rep = dg.to_dict()
+    assert [f["effect"] for f in rep["findings"]] == ["inertia"], dg.summary()
+    path = tmp_path / "aug.json"
+    lugre.save_model(dg.augmented_model(), path)
+    assert '"effect": "inertia"' in path.read_text()
+    again = lugre.load_model(path)
+    assert again.total_mass == pytest.approx(dg.augmented_model().total_mass)
+    assert "kg m^2" in diagnosis_page(rep, dg.data)

@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any, Union
 
 from .exceptions import InputError, ModelError, ParameterError, PassivityWarning
-from .vocabulary import ALIASES, EFFECTS, MASS_EFFECTS, canonical
+from .vocabulary import ALIASES, EFFECTS, INERTIA, MASS, MASS_EFFECTS, canonical
 
 __all__ = ["Model", "ModelLike", "load_model", "save_model"]
 
@@ -210,7 +210,16 @@ class Model:
         -------
         str
         """
-        return json.dumps(self._data, indent=indent, allow_nan=False)
+        return json.dumps(self._written(), indent=indent, allow_nan=False)
+
+    def _written(self) -> dict[str, Any]:
+        """The document as a file holds it: a rotary axis's ``mass`` effect written
+        ``inertia`` (CONTRACT, "Rotary axes"; read back as ``mass``)."""
+        effects = self._data.get("effects")
+        if not self.is_rotary or not effects:
+            return self._data
+        return {**self._data, "effects": [
+            {**e, "effect": INERTIA} if e.get("effect") == MASS else e for e in effects]}
 
     def _core_model(self) -> Any:
         """The model parsed by the compiled core (``lugre._core.Model``), built when the

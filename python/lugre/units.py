@@ -20,7 +20,7 @@ import re
 from collections.abc import Iterator
 from typing import Any
 
-from .vocabulary import EFFECTS
+from .vocabulary import EFFECTS, canonical
 
 __all__ = ["EFFECT_UNITS", "axis", "axis_kind", "axis_units", "base_unit", "constant_words",
            "display", "fmt", "fmt_range", "force_words", "is_rotary", "mass_words", "micro",
@@ -158,7 +158,7 @@ _DISPLAY = {"m": POSITION, "m/s": SPEED, "s": ("s", 1.0), "N": ("N", 1.0),
 
 def unit_of(effect: str | None, name: str) -> tuple[str, float]:
     """Display unit and factor of a parameter (``("", 1.0)`` when unknown)."""
-    spec = EFFECTS.get(effect or "")
+    spec = EFFECTS.get(canonical(effect or ""))
     if spec is not None and name in spec.units:
         return _on_axis(spec.units[name], spec.display[name])
     base = name.rsplit(".", 1)[-1]

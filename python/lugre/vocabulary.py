@@ -12,8 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 __all__ = ["ALIASES", "COGGING", "CURRENT_LAG", "CURRENT_LIMIT", "DEADBAND", "DELAY", "DRAG",
-           "DRIFT", "EFFECTS", "FORCE_RIPPLE", "GRAVITY", "LOAD_FRICTION", "MASS", "MASS_EFFECTS",
-           "NAMES", "OFFSET", "ONE_OF_A_KIND", "POSITION_FRICTION", "RESONANCE", "SPRING",
+           "DRIFT", "EFFECTS", "FORCE_RIPPLE", "GRAVITY", "INERTIA", "LOAD_FRICTION", "MASS",
+           "MASS_EFFECTS", "NAMES", "OFFSET", "ONE_OF_A_KIND", "POSITION_FRICTION", "RESONANCE", "SPRING",
            "STRIBECK_SHAPE", "TIMING", "TIMING_FORMS", "Effect", "Parameter", "canonical",
            "held_kinds", "is_timing", "kind"]
 
@@ -168,7 +168,8 @@ ONE_OF_A_KIND: tuple[str, ...] = tuple(dict.fromkeys(
 
 #: Other names the model file may give an effect: a rotary axis's ``mass`` effect is
 #: written ``inertia`` (CONTRACT, "Rotary axes").
-ALIASES: dict[str, str] = {"inertia": MASS}
+INERTIA = "inertia"
+ALIASES: dict[str, str] = {INERTIA: MASS}
 
 
 def canonical(effect: str) -> str:

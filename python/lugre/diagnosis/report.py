@@ -13,7 +13,7 @@ from .. import units as U
 from .._words import plain_text
 from ..model import Model
 from ..units import axis_units
-from ..vocabulary import is_timing
+from ..vocabulary import INERTIA, MASS, is_timing
 from .candidates.lag import timing_words
 
 __all__ = ["Diagnosis", "Finding"]
@@ -173,6 +173,16 @@ class Diagnosis:
                 for t in self.trials
             ],
         }
+        return self._rotary_names(d)
+
+    def _rotary_names(self, d: dict[str, Any]) -> dict[str, Any]:
+        """A rotary axis's report writes the ``mass`` effect ``inertia`` (CONTRACT)."""
+        if not self.model.is_rotary:
+            return d
+        for key in ("findings", "minor", "removed"):
+            for e in d.get(key) or []:
+                if e.get("effect") == MASS:
+                    e["effect"] = INERTIA
         return d
 
     def to_json(self, indent: int | None = 2) -> str:
