@@ -397,7 +397,8 @@ def _fit_and_write(args: argparse.Namespace, rec: Any, effects: list[str]) -> in
 
     if rec.F is None and args.force_constant is None:
         raise UsageError.option("--force-constant", f"{args.recording} holds the current i: "
-                                f"give the {_constant_words()} [{U.si('N/A')}] with "
+                                f"give the {U.constant_words()} "
+                                f"{'K_T' if U.is_rotary() else 'K_F'} [{U.si('N/A')}] with "
                                 "--force-constant")
     kf = args.force_constant or 1.0
     pr = _progress(args)
@@ -431,12 +432,6 @@ def _fit_and_write(args: argparse.Namespace, rec: Any, effects: list[str]) -> in
     return 0
 
 
-def _constant_words() -> str:
-    from . import units as U
-
-    return "torque constant K_T" if U.is_rotary() else "force constant K_F"
-
-
 def _print_model(model: Any, with_constant: bool) -> None:
     """The fitted base, each number in the axis's unit."""
     from . import units as U
@@ -445,7 +440,7 @@ def _print_model(model: Any, with_constant: bool) -> None:
         p = getattr(model, d)
         print(f"{d:8s} fc {p['fc']:.4g} {U.si('N')}  fs {p['fs']:.4g} {U.si('N')}  "
               f"sigma2 {p['sigma2']:.4g} {U.si('N s/m')}  vs {p['vs']:.4g} {U.si('m/s')}")
-    kf_txt = (f", {_constant_words().rsplit(' ', 1)[0]} {model.force_constant:.4g} "
+    kf_txt = (f", {U.constant_words()} {model.force_constant:.4g} "
               f"{U.si('N/A')}" if with_constant else "")
     print(f"{U.mass_words()} {model.mass:.4g} {U.si('kg')}, sigma0 {model.sigma0:.4g} "
           f"{U.si('N/m')}, sigma1 {model.sigma1:.4g} {U.si('N s/m')}{kf_txt}")
