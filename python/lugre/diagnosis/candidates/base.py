@@ -11,8 +11,8 @@ import numpy as np
 from ...model import Model
 from ..residual import Signals, base_friction
 
-__all__ = ["Candidate", "Context", "FindingView", "Said", "Term", "by", "grid_interval",
-           "objects"]
+__all__ = ["Candidate", "Context", "FindingView", "Said", "Term", "by", "by_current",
+           "grid_interval", "objects"]
 
 
 @dataclass
@@ -214,6 +214,16 @@ def by(key: str, xlabel: str):  # figure against position or velocity
         return {"x": x[o], "xlabel": xlabel, "residual": residual[m][o],
                 "effect": contrib[m][o]}
     return figure
+
+
+def by_current(self: Candidate, residual: np.ndarray, contrib: np.ndarray, ctx: Context
+               ) -> dict[str, Any]:
+    """A candidate's figure against the motor current (the drive's own effects)."""
+    m = ctx.sig.mask
+    i = ctx.sig.fm_f[m] / ctx.model.force_constant
+    o = np.argsort(i, kind="stable")
+    return {"x": i[o], "xlabel": "current [A]", "residual": residual[m][o],
+            "effect": contrib[m][o]}
 
 
 def objects(items: list[Any]) -> np.ndarray:

@@ -12,10 +12,10 @@ import numpy as np
 from ... import units as U
 from ...vocabulary import COGGING, CURRENT_LIMIT, FORCE_RIPPLE, LOAD_FRICTION
 from ..residual import position_sums
-from .base import Candidate, Context, by
+from .base import Candidate, Context, by, by_current
 from .linear import mass_both_ways
 from .position import Cogging
-from .probe import amps, hide, refit_on, share, start_of, under
+from .probe import amps, hide, share, two_ways, under
 from .secant import _Secant
 
 __all__ = ["BRAKING_SHARE", "CurrentLimit", "ForceRipple", "LoadFriction"]
@@ -151,13 +151,7 @@ class CurrentLimit(_Secant):
         return (f"Above {amps(c)} ({c * ctx.model.force_constant:.3g} "
                 f"{U.si('N')}) the drive gives no more {U.force_words()}.")
 
-    def figure(self, residual: np.ndarray, contrib: np.ndarray, ctx: Context
-               ) -> dict[str, Any]:
-        m = ctx.sig.mask
-        i = ctx.sig.fm_f[m] / ctx.model.force_constant
-        o = np.argsort(i, kind="stable")
-        return {"x": i[o], "xlabel": "current [A]", "residual": residual[m][o],
-                "effect": contrib[m][o]}
+    figure = by_current
 
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
         ia = np.abs(ctx.sig.fm[ctx.sig.mask]) / ctx.model.force_constant
@@ -202,21 +196,15 @@ def clip_both_ways(scorer: Any, terms: list[Any], k: int, ev: Any,
     rising, falling = over & (rate > 0), over & (rate < 0)
     if min(rising.sum(), falling.sum()) < 20:
         return None
-    full = float(ev.beta[start_of(scorer, terms, k)])
-    out: dict[str, Any] = {"coefficient": full}
-    for name, sel in (("rising", rising), ("falling", falling)):
-        fit = refit_on(scorer, terms, k, sel)
-        if fit is None:
-            return None
-        out[name], out[name + "_se"] = fit
+    out = two_ways(scorer, terms, k, ev, {"rising": rising, "falling": falling})
+    if out is None:
+        return None
     a, b = out["rising"], out["falling"]
-    se = float(np.hypot(out["rising_se"], out["falling_se"]))
     # (a real limit found at a grid point near it reads 1.1 rising and 0.74 falling; a
     # 64 Hz lag read 0.27 and 0.02: one side a third of the other or less, or of the
     # other sign, is no clip)
     lopsided = a * b <= 0 or min(abs(a), abs(b)) < CLIP_SIDES * max(abs(a), abs(b))
-    out["not_limit"] = bool(max(out["rising_se"], out["falling_se"]) < 0.25 * abs(full)
-                            and abs(a - b) > 4.0 * se and lopsided)
+    out["not_limit"] = bool(out.pop("apart") and lopsided)
     return out
 
 

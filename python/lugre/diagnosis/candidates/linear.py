@@ -11,7 +11,7 @@ from ...vocabulary import DRAG, LOAD_FRICTION, MASS, OFFSET, SPRING
 from .. import base as B
 from .. import residual as R
 from .base import Candidate, Context, FindingView, Said, by
-from .probe import hide, refit_on, start_of, under
+from .probe import hide, two_ways, under
 
 __all__ = ["ASYMMETRY_EXPERIMENT", "FORCE_FRICTION_EXPERIMENT", "Drag", "Mass", "Offset",
            "Spring"]
@@ -264,18 +264,13 @@ def mass_both_ways(scorer: Any, terms: list[Any], k: int, ev: Any,
     brake = m & (fv < 0)
     if up.sum() < 0.05 * m.sum() or brake.sum() < 0.05 * m.sum():
         return None
-    full = float(ev.beta[start_of(scorer, terms, k)])
-    out: dict[str, Any] = {"delta_kg": full}
-    for name, sel in (("speeding_up", up), ("braking", brake)):
-        fit = refit_on(scorer, terms, k, sel)
-        if fit is None:
-            return None
-        out[name], out[name + "_se"] = fit
-    a, b = out["speeding_up"], out["braking"]
-    se = float(np.hypot(out["speeding_up_se"], out["braking_se"]))
-    out["not_payload"] = bool(max(out["speeding_up_se"], out["braking_se"]) < 0.25 * abs(full)
-                              and abs(a - b) > 4.0 * se and abs(a - b) > 0.5 * abs(full))
-    return out
+    ways = two_ways(scorer, terms, k, ev, {"speeding_up": up, "braking": brake})
+    if ways is None:
+        return None
+    full, apart = ways.pop("coefficient"), ways.pop("apart")
+    a, b = ways["speeding_up"], ways["braking"]
+    return {"delta_kg": full, **ways,
+            "not_payload": bool(apart and abs(a - b) > 0.5 * abs(full))}
 
 
 def mass_alternative(delta: float, mass: float, sig: R.Signals,

@@ -11,7 +11,7 @@ from ... import units as U
 from .. import residual as R
 
 __all__ = ["amps", "hide", "rate_noise_power", "refit_on", "reversals", "share", "start_of",
-           "under"]
+           "two_ways", "under"]
 
 
 def start_of(scorer: Any, terms: list[Any], k: int) -> int:
@@ -35,6 +35,25 @@ def refit_on(scorer: Any, terms: list[Any], k: int, sel: np.ndarray,
         return None
     ev = scorer.like(mask=sel, center=None).evaluate(terms)
     return float(ev.beta[start_of(scorer, terms, k)]), float(np.sqrt(scorer.s2 / sxx))
+
+
+def two_ways(scorer: Any, terms: list[Any], k: int, ev: Any,
+             sets: dict[str, np.ndarray]) -> dict[str, Any] | None:
+    """The first coefficient of ``terms[k]`` refitted (:func:`refit_on`) on each of two
+    sets of samples, beside the full fit's: ``coefficient``, per set its value and
+    ``<name>_se``, and ``apart``: both sets determine it (standard errors under a quarter
+    of the full fit's) and they differ by more than four combined standard errors. None
+    when a set holds nothing of the term's column."""
+    full = float(ev.beta[start_of(scorer, terms, k)])
+    out: dict[str, Any] = {"coefficient": full}
+    for name, sel in sets.items():
+        fit = refit_on(scorer, terms, k, sel)
+        if fit is None:
+            return None
+        out[name], out[name + "_se"] = fit
+    (a, sa), (b, sb) = ((out[n], out[n + "_se"]) for n in sets)
+    out["apart"] = bool(max(sa, sb) < 0.25 * abs(full) and abs(a - b) > 4.0 * np.hypot(sa, sb))
+    return out
 
 
 def reversals(sig: R.Signals, window: float = 0.05) -> tuple[np.ndarray, int]:

@@ -12,7 +12,7 @@ from ...model import Model
 from ...vocabulary import DEADBAND, STRIBECK_SHAPE, is_timing
 from .. import residual as R
 from ..residual import Signals
-from .base import Candidate, Context, by, grid_interval
+from .base import Candidate, Context, by, by_current, grid_interval
 from .probe import amps, hide, refit_on, start_of
 
 __all__ = ["Deadband", "StribeckShape", "_Secant"]
@@ -156,13 +156,7 @@ class Deadband(_Secant):
         return (f"Currents under {d * 1e3:.3g} mA give no force ({force:.3g}"
                 f" {n} of motor force lost at each sign change of the current).")
 
-    def figure(self, residual: np.ndarray, contrib: np.ndarray, ctx: Context
-               ) -> dict[str, Any]:
-        m = ctx.sig.mask
-        i = ctx.sig.fm_f[m] / ctx.model.force_constant
-        o = np.argsort(i, kind="stable")
-        return {"x": i[o], "xlabel": "current [A]", "residual": residual[m][o],
-                "effect": contrib[m][o]}
+    figure = by_current
 
     check_rank = 2
 
