@@ -144,24 +144,9 @@ def axis_model(seed: int) -> Model:
     rng = np.random.default_rng(seed + 7000)
     m = float(np.exp(rng.uniform(np.log(6.0), np.log(90.0))))
     kf = float(rng.uniform(10.0, 60.0))
-    fc = 10.0 * m * rng.uniform(0.02, 0.08)
-    sets = {}
-    for side in ("positive", "negative"):
-        f = fc * (1 + 0.05 * rng.standard_normal())
-        sets[side] = {"fc": f, "fs": f * rng.uniform(1.3, 2.2),
-                      "sigma2": m * rng.uniform(4.0, 16.0),
-                      "vs": float(np.exp(rng.uniform(np.log(0.003), np.log(0.02))))}
-    s0 = 3.0 * max(sets["positive"]["fs"], sets["negative"]["fs"]) / 1e-3 * rng.uniform(0.5, 2)
-    g = m / 25.0
-    rate = float(rng.choice([5000.0, 10000.0]))
-    return Model({
-        "axis": {"mass": m, "force_constant": kf},
-        "friction": {"model": "lugre", "sigma0": s0, "sigma1": 0.3 * np.sqrt(s0 * m) * 0.05,
-                     **sets},
-        "effects": [],
-        "controller": {"type": "pid", "kp": 5e4 * g, "ki": 5e5 * g, "kd": 1500.0 * g,
-                       "rate_hz": rate},
-    })
+    sets, s0 = _friction(rng, m, 10.0 * m * rng.uniform(0.02, 0.08), (0.003, 0.02))
+    return _pid_axis({"mass": m, "force_constant": kf}, m, sets, s0,
+                     float(rng.choice([5000.0, 10000.0])))
 
 
 def rotary_model(seed: int) -> Model:
@@ -172,22 +157,36 @@ def rotary_model(seed: int) -> Model:
     rng = np.random.default_rng(seed + 9000)
     j = float(np.exp(rng.uniform(np.log(0.005), np.log(2.0))))
     kt = float(np.exp(rng.uniform(np.log(0.2), np.log(5.0))))
-    fc = 20.0 * j * rng.uniform(0.02, 0.08)
+    sets, s0 = _friction(rng, j, 20.0 * j * rng.uniform(0.02, 0.08), (0.01, 0.1))
+    return _pid_axis({"kind": "rotary", "inertia": j, "torque_constant": kt}, j, sets, s0,
+                     float(rng.choice([4000.0, 8000.0])))
+
+
+def _friction(rng: np.random.Generator, m: float, fc: float, vs: tuple[float, float]
+              ) -> tuple[dict[str, dict[str, float]], float]:
+    """Random static sets about ``fc`` (static 1.3-2.2x, viscous 4-16 times the mass,
+    Stribeck speeds log-uniform over ``vs``) and a bristle stiffness for them."""
     sets = {}
     for side in ("positive", "negative"):
         f = fc * (1 + 0.05 * rng.standard_normal())
         sets[side] = {"fc": f, "fs": f * rng.uniform(1.3, 2.2),
-                      "sigma2": j * rng.uniform(4.0, 16.0),
-                      "vs": float(np.exp(rng.uniform(np.log(0.01), np.log(0.1))))}
+                      "sigma2": m * rng.uniform(4.0, 16.0),
+                      "vs": float(np.exp(rng.uniform(np.log(vs[0]), np.log(vs[1]))))}
     s0 = 3.0 * max(sets["positive"]["fs"], sets["negative"]["fs"]) / 1e-3 * rng.uniform(0.5, 2)
-    g = j / 25.0
+    return sets, s0
+
+
+def _pid_axis(axis: dict[str, Any], m: float, sets: dict[str, Any], s0: float,
+              rate: float) -> Model:
+    """The model of a random axis under a PID with the paper axis's bandwidth."""
+    g = m / 25.0
     return Model({
-        "axis": {"kind": "rotary", "inertia": j, "torque_constant": kt},
-        "friction": {"model": "lugre", "sigma0": s0, "sigma1": 0.3 * np.sqrt(s0 * j) * 0.05,
+        "axis": axis,
+        "friction": {"model": "lugre", "sigma0": s0, "sigma1": 0.3 * np.sqrt(s0 * m) * 0.05,
                      **sets},
         "effects": [],
         "controller": {"type": "pid", "kp": 5e4 * g, "ki": 5e5 * g, "kd": 1500.0 * g,
-                       "rate_hz": float(rng.choice([4000.0, 8000.0]))},
+                       "rate_hz": rate},
     })
 
 
