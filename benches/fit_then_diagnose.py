@@ -31,11 +31,14 @@ def main() -> None:
         for fn in ("recording.csv", "holdout.csv", "truth.json"):
             shutil.copyfile(d / fn, o / fn)
         believed = json.loads((d / "model.json").read_text())
+        axis = believed["axis"]
+        rotary = axis.get("kind") == "rotary"  # (joints: inertia, torque constant, rad)
         cmd = [sys.executable, "-m", "lugre", "fit", str(d / "recording.csv"), "-q",
-               "--force-constant", str(believed["axis"]["force_constant"]),
-               "--json", str(o / "fitted.json")]
+               "--force-constant",
+               str(axis["torque_constant" if rotary else "force_constant"]),
+               "--json", str(o / "fitted.json")] + (["--x-unit", "rad"] if rotary else [])
         if a.mass:
-            cmd += ["--mass", str(believed["axis"]["mass"])]
+            cmd += ["--mass", str(axis["inertia" if rotary else "mass"])]
         r = subprocess.run(cmd, capture_output=True, text=True, check=False)
         if r.returncode:
             print(f"{d.name}: fit failed: {r.stderr.strip()}", flush=True)
