@@ -494,6 +494,49 @@ def _cmd_paper(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_fleet_run(args: argparse.Namespace) -> int:
+    from .fleet import run
+
+    _check_outputs({"DIR": args.dir}, {"--db": args.db})
+    summary = run(args.dir, args.db, scheduler=args.scheduler, workers=args.workers,
+                  progress=_progress(args))
+    print(summary.text())
+    for e in summary.errors:
+        print(f"  not diagnosed: {e['axis']}/{e['recording']}: {e['error']}")
+    print(f"history in {args.db}: lugre fleet report --db {args.db} --html FLEET.html")
+    return 0
+
+
+def _cmd_fleet_report(args: argparse.Namespace) -> int:
+    from .fleet import report
+
+    _check_outputs({"--db": args.db}, {"--html": args.html, "--json": args.json},
+                   {"--parquet": args.parquet})
+    if args.parquet:
+        out = os.path.abspath(args.parquet)
+        where = out if os.path.isdir(out) else os.path.dirname(out)
+        if not os.path.isdir(where):
+            raise UsageError.option("--parquet", f"cannot write {args.parquet}: the directory "
+                                    f"{where} does not exist: create it first")
+        if not os.access(where, os.W_OK):
+            raise UsageError.option("--parquet", f"cannot write into {where}: no permission: "
+                                    "choose another directory")
+    with _progress(args).step("assessing the fleet and writing its outputs"):
+        doc = report(args.db, html=args.html, json=args.json, parquet=args.parquet)
+    ranked = doc["ranking"]
+    print(f"{len(ranked)} axes, {sum(1 for r in ranked if r['alarms'])} with an alarm, "
+          f"{len(doc['errors'])} recordings not diagnosed")
+    for a in doc["alarms"]:
+        print(f"  {a['axis']}: {a['kind']}{' ' + a['effect'] if a['effect'] else ''} since "
+              f"{a['since']}")
+    for opt, path in (("page", args.html), ("alarms", args.json)):
+        if path:
+            print(f"{opt} written to {path}")
+    if args.parquet:
+        print(f"Parquet tables written to {args.parquet}/")
+    return 0
+
+
 # --------------------------------------------------------------------------------------
 # Parser
 # --------------------------------------------------------------------------------------
@@ -528,6 +571,8 @@ _EXAMPLES = {
            "  lugre fit joint.csv --x-unit deg --force-constant 0.6 --json joint.json",
     "paper": "lugre paper --out paper/ --html paper.html",
     "design-static": "lugre design-static points.csv --target 0.003 --budget 96 --json design.json",
+    "fleet": "lugre fleet run plant/ --db fleet.duckdb --workers 4\n"
+             "  lugre fleet report --db fleet.duckdb --html fleet.html --json ALARMS.json",
 }
 
 
@@ -680,7 +725,39 @@ def build_parser() -> argparse.ArgumentParser:
                     help="static datasets for the Monte Carlo summary (0 to skip)")
     pp.add_argument("--html", metavar="PAGE.html", help="the tables as a self-contained page")
     pp.set_defaults(func=_cmd_paper)
+    _fleet_parser(sub, common)
     return p
+
+
+def _fleet_parser(sub: Any, common: list[argparse.ArgumentParser]) -> None:
+    fl = _add(sub, "fleet", "diagnose every recording of a fleet of axes on a Dask cluster, "
+              "keep the history, and report which axes changed, how and since when", common)
+    fsub = fl.add_subparsers(dest="fleet_command", metavar="SUBCOMMAND")
+    fl.set_defaults(func=lambda args: (fl.print_help(), 2)[1])
+    fr = fsub.add_parser("run", parents=common, formatter_class=_Formatter,
+                         help="diagnose the recordings not yet in the history",
+                         description="Diagnose every recording of DIR/AXIS/ not yet in the "
+                         "history against DIR/AXIS/model.json, on a Dask cluster.")
+    fr.add_argument("dir", metavar="DIR", help="one folder per axis: AXIS/model.json and "
+                    "its recordings (.csv, .mat, .npz, .parquet, .h5)")
+    fr.add_argument("--db", required=True, metavar="FLEET.duckdb",
+                    help="the history (DuckDB), created when missing")
+    fr.add_argument("--scheduler", metavar="ADDRESS",
+                    help="a running Dask scheduler (tcp://host:8786) whose workers read DIR")
+    fr.add_argument("--workers", type=_COUNT, metavar="N",
+                    help="processes of the local cluster (default: the machine's cores)")
+    fr.set_defaults(func=_cmd_fleet_run)
+    fp = fsub.add_parser("report", parents=common, formatter_class=_Formatter,
+                         help="alarms, trends and the fleet page from the history",
+                         description="The axes ranked by change, with their alarms and "
+                         "trends, from the history.")
+    fp.add_argument("--db", required=True, metavar="FLEET.duckdb", help="the history")
+    fp.add_argument("--html", metavar="FLEET.html", help="the fleet page (one file)")
+    fp.add_argument("--json", metavar="ALARMS.json", help="the alarms and the recordings "
+                    "not diagnosed")
+    fp.add_argument("--parquet", metavar="OUTDIR",
+                    help="export each table of the history as OUTDIR/TABLE.parquet")
+    fp.set_defaults(func=_cmd_fleet_report)
 
 
 def _show_warning(message: Any, category: Any, filename: str, lineno: int,

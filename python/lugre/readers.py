@@ -1,4 +1,5 @@
-"""Readers and writers of recordings and steady-state points (CSV, ``.npz``, ``.mat``).
+"""Readers and writers of recordings and steady-state points (CSV, ``.npz``, ``.mat``, and
+through :mod:`lugre.columnar` ``.parquet`` and ``.h5``).
 
 CSV files may start with ``#`` lines (``# key: value`` lines become
 :attr:`~lugre.recording.Recording.meta`), then one header line, then comma-separated
@@ -27,6 +28,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ._atomic import atomic_write as _atomic_write
+from .columnar import COLUMNAR_SUFFIXES, read_columnar, write_columnar
 from .columns import _SAMPLE_TIME_NAMES, ColumnSpec, _is_number, _missing, _parse_columns, _terms
 from .exceptions import FileFormatError, InputError
 from .recording import COLUMNS, Recording
@@ -130,11 +132,14 @@ def _csv_column(path: str, header: list[str], rows: list[tuple[int, list[str]]],
 
 
 def _read_arrays(path: str, suffix: str) -> tuple[dict[str, np.ndarray], dict[str, str]]:
-    """Variables of a ``.npz`` or ``.mat`` file, squeezed, and metadata."""
+    """Variables of a ``.npz``, ``.mat``, ``.parquet`` or ``.h5`` file, squeezed, and
+    metadata."""
     meta: dict[str, str] = {}
     if not os.path.exists(path):
         raise FileNotFoundError(2, f"recording {path!r} does not exist", path)
-    if suffix == ".npz":
+    if suffix in COLUMNAR_SUFFIXES:
+        raw, meta = read_columnar(path, suffix)
+    elif suffix == ".npz":
         try:
             with np.load(path, allow_pickle=False) as z:
                 raw = {k: z[k] for k in z.files}
@@ -197,12 +202,13 @@ _MEASURED = ("t", "x", "i", "F")
 
 def read_recording(path: str | os.PathLike[str], columns: ColumnSpec = None, *,
                    x_unit: str = "m") -> Recording:
-    """Read a recording from CSV, ``.npz`` or MATLAB ``.mat``.
+    """Read a recording from CSV, ``.npz``, MATLAB ``.mat``, Parquet or HDF5.
 
     Parameters
     ----------
     path : str or os.PathLike
-        The file. ``.npz`` and ``.mat`` by their suffix, anything else as CSV.
+        The file. ``.npz``, ``.mat``, ``.parquet`` and ``.h5`` (``.hdf5``) by their
+        suffix, anything else as CSV (Parquet needs pyarrow, HDF5 h5py).
     columns : dict or iterable of str or str, optional
         Where to find the recording's columns (``t``, ``x``, ``i``, ``F``, ``v``,
         ``x_ref``, ``v_ref``) when the file names them otherwise: ``{"x": "qm"}``,
@@ -247,7 +253,7 @@ def read_recording(path: str | os.PathLike[str], columns: ColumnSpec = None, *,
                             f"{', '.join(X_UNITS)}")
     mapping = _parse_columns(columns)
     suffix = Path(p).suffix.lower()
-    csv = suffix not in (".npz", ".mat")
+    csv = suffix not in (".npz", ".mat", *COLUMNAR_SUFFIXES)
     if csv:
         meta, header, rows = _read_csv_table(p)
         names: list[str] = header
@@ -409,7 +415,8 @@ def write_recording(path: Any, rec: Any) -> None:
     Parameters
     ----------
     path : str or os.PathLike
-        Destination. ``.npz`` and ``.mat`` by suffix, otherwise CSV: the ``meta``
+        Destination. ``.npz``, ``.mat``, ``.parquet`` and ``.h5`` by suffix (the last
+        two keep ``meta`` as the file's metadata), otherwise CSV: the ``meta``
         entries as ``# key: value`` lines, the header, then the numbers in their
         shortest exact (round-trip) form.
     rec : Recording
@@ -432,6 +439,9 @@ def write_recording(path: Any, rec: Any) -> None:
         extra = {"_meta": np.array(json.dumps(rec.meta))} if rec.meta else {}
         np.savez(buf, **{c: getattr(rec, c) for c in cols}, **extra)
         data = buf.getvalue()
+    elif suffix in COLUMNAR_SUFFIXES:
+        data = write_columnar(suffix, os.fspath(path), {c: getattr(rec, c) for c in cols},
+                              rec.meta)
     elif suffix == ".mat":
         import scipy.io
 
