@@ -2,7 +2,7 @@
 
 ``write_fleet(DIR)`` writes ``DIR/AXIS/model.json`` and one recording a night per axis:
 20 axes (17 linear from :func:`lugre.diagnosis.synth.axis_model`, 3 rotary from
-``rotary_model``) over 11 nights, each night's friction levels scattered by a few per
+``rotary_model``) over 10 nights, each night's friction levels scattered by a few per
 cent (temperature), and
 
 - three axes wearing: their Coulomb and static levels rise 6 % a night from night 5;
@@ -31,7 +31,7 @@ from lugre import Model, Recording, save_model, simulate, write_recording
 from lugre.diagnosis.synth import axis_model, rotary_model, trajectory
 
 AXES = 20
-NIGHTS = 11
+NIGHTS = 10
 START = dt.datetime(2024, 3, 1, 2, 0, 0)
 DURATION = 3.0
 RATE_HZ = 1000.0
