@@ -1424,3 +1424,43 @@ def test_scalar_for_an_array_same_error(call):
             call(backend)
         msgs.append(str(e.value))
     assert msgs[0] == msgs[1] and "1-D" in msgs[0], msgs
+
+
+# ---- the diagnosis's zero-phase low-pass and moving median (issue 28: no scipy.signal)
+
+
+@pytest.mark.parametrize("n", [1, 2, 5, 73, 74, 2000])
+@pytest.mark.parametrize("order,wn", [(4, 0.08), (4, 0.3), (2, 0.01), (3, 0.5)])
+def test_filtfilt_twins_and_scipy(n, order, wn):
+    """The core's filter, its twin and SciPy's ``sosfiltfilt`` agree to 1e-13 of the
+    signal's scale (the core flushes states under 1e-270; SciPy's start states come from
+    a linear solve)."""
+    from lugre import _native
+    from lugre.diagnosis.dsp import butter_sos
+    from lugre.reference import kernels as K
+    from scipy import signal
+
+    y = np.cumsum(np.random.default_rng(n).standard_normal(n))
+    sos = butter_sos(order, wn)
+    padlen = min(72, n - 1)
+    a, b = _native.filtfilt(y, sos, padlen), K.filtfilt(y, sos, padlen)
+    c = signal.sosfiltfilt(sos, y, padtype="odd", padlen=padlen)
+    scale = max(float(np.max(np.abs(y))), 1e-300)
+    np.testing.assert_allclose(a, b, rtol=0, atol=1e-13 * scale)
+    np.testing.assert_allclose(a, c, rtol=0, atol=1e-13 * scale)
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 10, 11, 12, 3001])
+@pytest.mark.parametrize("size", [1, 3, 11])
+def test_moving_median_twins_and_scipy(n, size):
+    """The core's moving median, its twin and ``scipy.ndimage.median_filter(mode=
+    "nearest")`` give the same values (ties included: the samples are rounded)."""
+    from lugre import _native
+    from lugre.reference import kernels as K
+    from scipy import ndimage
+
+    y = np.round(np.random.default_rng(n + size).standard_normal(n), 1)
+    a, b = _native.moving_median(y, size), K.moving_median(y, size)
+    np.testing.assert_array_equal(a, b)
+    if n:
+        np.testing.assert_array_equal(a, ndimage.median_filter(y, size=size, mode="nearest"))

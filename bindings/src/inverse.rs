@@ -5,7 +5,8 @@ use super::{slice, to_py};
 use lugre::error::Error;
 use lugre::estimate::Weighting;
 use lugre::inverse::{
-    fit_base as base_fit, position_sums as sums, BaseFitOptions, BaseParam, Lowpass, Record,
+    fit_base as base_fit, moving_median as median, position_sums as sums, BaseFitOptions,
+    BaseParam, Lowpass, Record, LANES,
 };
 use lugre::servo::Model;
 use numpy::ndarray::Array2;
@@ -100,8 +101,8 @@ fn columns(n: usize, cols: &[Vec<f64>]) -> Array2<f64> {
 fn columns_major(n: usize, cols: Vec<Vec<f64>>) -> Array2<f64> {
     let m = cols.len();
     let mut data: Vec<f64> = Vec::with_capacity(n * m);
-    for c in &cols {
-        data.extend_from_slice(c);
+    for c in cols {
+        data.extend_from_slice(&c); // (each column freed once copied)
     }
     Array2::from_shape_vec((m, n), data)
         .expect("columns of equal length")
@@ -127,27 +128,7 @@ impl PyInverseRecord {
         padlen: usize,
     ) -> PyResult<Self> {
         let rec = (|| -> Result<Record, Error> {
-            let filter = match &sos {
-                None => Lowpass::identity(),
-                Some(s) => {
-                    let s = s.as_array();
-                    if s.ncols() != 6 {
-                        return Err(Error::input(
-                            "sos",
-                            format!(
-                                "has {} columns: give one row [b0, b1, b2, 1, a1, a2] per section",
-                                s.ncols()
-                            ),
-                        ));
-                    }
-                    let rows = s
-                        .rows()
-                        .into_iter()
-                        .map(|r| [r[0], r[1], r[2], r[3], r[4], r[5]])
-                        .collect();
-                    Lowpass::new(rows, padlen)?
-                }
-            };
+            let filter = lowpass_of(sos.as_ref(), padlen)?;
             Record::new(
                 vec_of("t", &t)?,
                 vec_of("x", &x)?,
@@ -195,9 +176,24 @@ impl PyInverseRecord {
                 ),
             ));
         }
-        let cols: Vec<Vec<f64>> = a.columns().into_iter().map(|c| c.to_vec()).collect();
-        let out = py.detach(|| self.rec.filt_many(&cols));
-        Ok(columns(n, &out).into_pyarray(py))
+        // a few columns at a time, each written into the result as it is filtered: the
+        // matrix of a long record is hundreds of MB, and copies of all its columns in and
+        // out would triple that (the same numbers: every column is filtered on its own)
+        let m = a.ncols();
+        let out = py.detach(|| {
+            let mut out = Array2::<f64>::zeros((n, m));
+            let wave = 2 * LANES;
+            for j0 in (0..m).step_by(wave) {
+                let j1 = (j0 + wave).min(m);
+                let cols: Vec<Vec<f64>> = (j0..j1).map(|j| a.column(j).to_vec()).collect();
+                for (j, c) in (j0..j1).zip(self.rec.filt_many(&cols)) {
+                    out.column_mut(j)
+                        .assign(&numpy::ndarray::ArrayView1::from(&c));
+                }
+            }
+            out
+        });
+        Ok(out.into_pyarray(py))
     }
 
     /// Product of the position and drift scales of friction, or None.
@@ -364,6 +360,59 @@ impl PyInverseRecord {
         let jac = columns(n, &s.columns);
         Ok((s.force.into_pyarray(py), jac.into_pyarray(py), s.nonzero))
     }
+}
+
+/// The parallel low-pass of `sos` rows `[b0, b1, b2, 1, a1, a2]` (None: none).
+fn lowpass_of(sos: Option<&PyReadonlyArray2<'_, f64>>, padlen: usize) -> Result<Lowpass, Error> {
+    match sos {
+        None => Ok(Lowpass::identity()),
+        Some(s) => {
+            let s = s.as_array();
+            if s.ncols() != 6 {
+                return Err(Error::input(
+                    "sos",
+                    format!(
+                        "has {} columns: give one row [b0, b1, b2, 1, a1, a2] per section",
+                        s.ncols()
+                    ),
+                ));
+            }
+            let rows = s
+                .rows()
+                .into_iter()
+                .map(|r| [r[0], r[1], r[2], r[3], r[4], r[5]])
+                .collect();
+            Lowpass::new(rows, padlen)
+        }
+    }
+}
+
+/// `y` through the sections `sos` forward and backward, odd extension of `padlen`
+/// samples (the diagnosis's low-pass of a signal before its kernel exists; see
+/// `lugre::inverse::Lowpass::filtfilt`).
+#[pyfunction]
+#[pyo3(signature = (y, sos, padlen))]
+pub(crate) fn filtfilt<'py>(
+    py: Python<'py>,
+    y: PyReadonlyArray1<'py, f64>,
+    sos: PyReadonlyArray2<'py, f64>,
+    padlen: usize,
+) -> PyResult<F64Array<'py>> {
+    let ys = slice("y", &y).map_err(|e| to_py(py, e))?;
+    let filter = lowpass_of(Some(&sos), padlen).map_err(|e| to_py(py, e))?;
+    Ok(py.detach(|| filter.filtfilt(ys)).into_pyarray(py))
+}
+
+/// The moving median of `y` over `size` samples, the ends extended by their edge values
+/// (`lugre::inverse::moving_median`; SciPy's `ndimage.median_filter(mode="nearest")`).
+#[pyfunction]
+pub(crate) fn moving_median<'py>(
+    py: Python<'py>,
+    y: PyReadonlyArray1<'py, f64>,
+    size: usize,
+) -> PyResult<F64Array<'py>> {
+    let ys = slice("y", &y).map_err(|e| to_py(py, e))?;
+    Ok(py.detach(|| median(ys, size)).into_pyarray(py))
 }
 
 /// Sums of `r` against `sin` and `cos` of `2*pi*k_j*x` for `k_j = k0 + j*dk`, `j < n`:

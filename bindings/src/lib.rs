@@ -372,6 +372,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate_batch, m)?)?;
     m.add_function(wrap_pyfunction!(num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(inverse::position_sums, m)?)?;
+    m.add_function(wrap_pyfunction!(inverse::filtfilt, m)?)?;
+    m.add_function(wrap_pyfunction!(inverse::moving_median, m)?)?;
     m.add_function(wrap_pyfunction!(estimate::fit_static_points, m)?)?;
     m.add_function(wrap_pyfunction!(estimate::plateaus, m)?)?;
     m.add_function(wrap_pyfunction!(estimate::fit_dynamic_record, m)?)?;

@@ -325,6 +325,12 @@ def fit_dynamic_record(
     integrator: str = "exact",
 ) -> DynamicFitResult: ...
 
+def filtfilt(
+    y: npt.NDArray[np.float64],
+    sos: npt.NDArray[np.float64],
+    padlen: int,
+) -> npt.NDArray[np.float64]: ...
+def moving_median(y: npt.NDArray[np.float64], size: int) -> npt.NDArray[np.float64]: ...
 def position_sums(
     x: npt.NDArray[np.float64],
     r: npt.NDArray[np.float64],

@@ -23,10 +23,12 @@ from ._args import (
     select_drive,
 )
 from ._core import InverseRecord
+from ._core import filtfilt as core_filtfilt
 from ._core import friction_force as core_friction_force
 from ._core import irls_linear as core_irls_linear
 from ._core import irls_linear_grid as core_irls_linear_grid
 from ._core import load_coupling as core_load_coupling
+from ._core import moving_median as core_moving_median
 from ._core import position_sums as core_position_sums
 from ._core import simulate as core_simulate
 from ._core import simulate_batch as core_simulate_batch
@@ -35,8 +37,8 @@ from ._result import CouplingResult, GridFit, LinearFit, SimResult
 from .exceptions import InputError, ParameterError
 from .model import ModelLike, _as_model
 
-__all__ = ["InverseRecord", "friction_force", "irls_linear", "irls_linear_grid", "load_coupling",
-           "position_sums", "simulate", "simulate_batch", "stribeck"]
+__all__ = ["InverseRecord", "filtfilt", "friction_force", "irls_linear", "irls_linear_grid", "load_coupling",
+           "moving_median", "position_sums", "simulate", "simulate_batch", "stribeck"]
 
 
 def _array(name: str, a: Any) -> np.ndarray:
@@ -192,6 +194,29 @@ def load_coupling(
     n_sub = _substeps(substeps)
     f, xl, vl, z = core_load_coupling(xx, vv, dtf, mj, sc, ex, _float("z0", z0), n_sub)
     return CouplingResult(f, xl, vl, z)
+
+
+def filtfilt(y: Any, sos: Any, padlen: int) -> np.ndarray:
+    """``y`` through the second-order sections ``sos`` (rows ``[b0, b1, b2, 1, a1, a2]``)
+    forward and backward, odd extension of ``min(padlen, len(y) - 1)`` samples at each
+    end: SciPy's ``sosfiltfilt(sos, y, padtype="odd", padlen=padlen)`` in the core (the
+    low-pass of ``InverseRecord.filt``, states under 1e-270 flushed to zero), equal to
+    it to about 1e-15 of the signal's scale; the same as
+    :func:`lugre.reference.kernels.filtfilt`."""
+    yy = _array("y", y)
+    ss = np.ascontiguousarray(np.asarray(sos, dtype=float))
+    if ss.ndim != 2:
+        raise InputError.at("sos", "must be a matrix with one row [b0, b1, b2, 1, a1, a2] "
+                            "per section")
+    return core_filtfilt(yy, ss, int(padlen))
+
+
+def moving_median(y: Any, size: int) -> np.ndarray:
+    """The moving median of ``y`` over ``size`` samples centred on each, the ends
+    extended by their edge values: SciPy's ``ndimage.median_filter(y, size=size,
+    mode="nearest")``, value for value, in the core; the same as
+    :func:`lugre.reference.kernels.moving_median`."""
+    return core_moving_median(_array("y", y), int(size))
 
 
 def position_sums(x: Any, r: Any, k0: float, dk: float, n: int, *, squares: bool = False

@@ -343,8 +343,51 @@ fn cut(mut ext: Vec<f64>, edge: usize, n: usize) -> Vec<f64> {
     ext
 }
 
+/// The moving median of `y` over `size` samples centred on each (the element of rank
+/// `size / 2` of the window, sorted), the ends extended by their edge values: SciPy's
+/// `ndimage.median_filter(y, size=size, mode="nearest")` of a signal, value for value
+/// (a median selects, it computes nothing). The window is kept sorted: each step
+/// removes the sample that leaves and inserts the one that enters.
+pub fn moving_median(y: &[f64], size: usize) -> Vec<f64> {
+    let n = y.len();
+    if n == 0 || size <= 1 {
+        return y.to_vec();
+    }
+    let half = size / 2;
+    // the sample at extended index j (j - half into y, clamped to its ends)
+    let at = |j: usize| y[j.saturating_sub(half).min(n - 1)];
+    let mut win: Vec<f64> = (0..size).map(at).collect();
+    win.sort_by(f64::total_cmp);
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        out.push(win[half]);
+        if i + 1 == n {
+            break;
+        }
+        let leave = at(i);
+        let k = win.partition_point(|v| v.total_cmp(&leave).is_lt());
+        win.remove(k);
+        let enter = at(i + size);
+        let k = win.partition_point(|v| v.total_cmp(&enter).is_lt());
+        win.insert(k, enter);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn moving_median_selects_the_middle_of_each_window() {
+        let y = [5.0, 1.0, 4.0, 2.0, 3.0, 9.0, -1.0];
+        // windows of 3, ends extended: [5 5 1] [5 1 4] [1 4 2] [4 2 3] [2 3 9] [3 9 -1] [9 -1 -1]
+        assert_eq!(
+            super::moving_median(&y, 3),
+            vec![5.0, 4.0, 2.0, 3.0, 3.0, 3.0, -1.0]
+        );
+        assert_eq!(super::moving_median(&y[..1], 11), vec![5.0]);
+        assert!(super::moving_median(&[], 5).is_empty());
+    }
+
     use super::*;
 
     #[test]

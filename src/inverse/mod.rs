@@ -24,7 +24,7 @@ mod fit;
 mod sensitivities;
 mod spectrum;
 
-pub use filter::{Lowpass, LANES};
+pub use filter::{moving_median, Lowpass, LANES};
 pub use fit::{fit_base, BaseFit, BaseFitOptions, FitParam};
 pub use sensitivities::{BaseParam, Sensitivities};
 pub use spectrum::{position_sums, PositionSums, MAX_FREQUENCIES, RESEED};

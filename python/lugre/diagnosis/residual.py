@@ -21,12 +21,12 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from scipy import signal
 
 from .. import units as U
 from ..exceptions import DataError, InputError, UnitsWarning
 from ..io import Recording
 from ..model import Model, _as_model
+from . import dsp
 
 __all__ = [
     "Signals",
@@ -48,8 +48,10 @@ MIN_SAMPLES = 400
 _PADLEN = 3 * 24
 
 
-def lowpass(y: np.ndarray, cutoff_hz: float, fs: float, order: int = 4) -> np.ndarray:
-    """Zero-phase Butterworth low-pass (``sosfiltfilt``) along the first axis.
+def lowpass(y: np.ndarray, cutoff_hz: float, fs: float, order: int = 4, *,
+            backend: Any = "core") -> np.ndarray:
+    """Zero-phase Butterworth low-pass (SciPy's ``sosfiltfilt``, in the kernels of
+    ``backend``: :func:`kernels`) along the first axis.
 
     Parameters
     ----------
@@ -61,6 +63,8 @@ def lowpass(y: np.ndarray, cutoff_hz: float, fs: float, order: int = 4) -> np.nd
         Sample rate [Hz].
     order : int, default 4
         Filter order (applied twice).
+    backend : "core" or module, default "core"
+        The kernels that run the filter (:func:`kernels`).
 
     Returns
     -------
@@ -69,16 +73,26 @@ def lowpass(y: np.ndarray, cutoff_hz: float, fs: float, order: int = 4) -> np.nd
     wn = cutoff_hz / (0.5 * fs)
     if wn >= 0.99:
         return np.array(y, dtype=float, copy=True)
-    return signal.sosfiltfilt(_butter(order, wn), y, axis=0, padtype="odd",
-                              padlen=min(_PADLEN, len(y) - 1))
+    y = np.asarray(y, dtype=float)
+    sos, padlen = _butter(order, wn), min(_PADLEN, len(y) - 1)
+    run = kernels(backend).filtfilt
+    if y.ndim == 1:
+        return run(y, sos, padlen)
+    out = np.empty(y.shape)
+    for j in np.ndindex(y.shape[1:]):
+        out[(slice(None), *j)] = run(np.ascontiguousarray(y[(slice(None), *j)]), sos, padlen)
+    return out
 
 
 @functools.lru_cache(maxsize=16)
 def _butter(order: int, wn: float) -> np.ndarray:
-    return signal.butter(order, wn, output="sos")  # (sosfiltfilt does not write to it)
+    sos = dsp.butter_sos(order, wn)
+    sos.setflags(write=False)  # (shared by the cache)
+    return sos
 
 
-def hampel(y: np.ndarray, half_window: int = 5, k: float = 5.0) -> tuple[np.ndarray, np.ndarray]:
+def hampel(y: np.ndarray, half_window: int = 5, k: float = 5.0, *, backend: Any = "core"
+           ) -> tuple[np.ndarray, np.ndarray]:
     """Replace isolated one-sample spikes by the local median (Hampel identifier).
 
     A sample is a spike when it deviates from the moving median by more than ``k``
@@ -98,6 +112,8 @@ def hampel(y: np.ndarray, half_window: int = 5, k: float = 5.0) -> tuple[np.ndar
         Half width of the moving window [samples].
     k : float, default 5.0
         Threshold in robust standard deviations of the deviation from the local median.
+    backend : "core" or module, default "core"
+        The kernels that take the moving median (:func:`kernels`).
 
     Returns
     -------
@@ -105,9 +121,7 @@ def hampel(y: np.ndarray, half_window: int = 5, k: float = 5.0) -> tuple[np.ndar
     spikes : numpy.ndarray of bool
         Where a sample was replaced.
     """
-    from scipy.ndimage import median_filter
-
-    med = median_filter(y, size=2 * half_window + 1, mode="nearest")
+    med = kernels(backend).moving_median(np.asarray(y, dtype=float), 2 * half_window + 1)
     dev = y - med
     ad = np.abs(dev)
     ad = ad[ad > 0]
@@ -375,7 +389,7 @@ def prepare(
     dt = rec.dt
     fs = 1.0 / dt
     force_raw = rec.force(model)
-    fm, spikes = hampel(force_raw)
+    fm, spikes = hampel(force_raw, backend=backend)
     # the noise levels are read from the force as logged: the interpolation that
     # moves it by the controller's hold would smooth its noise near Nyquist
     limit = reading_band(rec.x, fm, fs, float(model.mass))
@@ -410,15 +424,16 @@ def prepare(
         dt, fs = dt * step, fs / step
     n = xr.size
     fd = float(drive_cutoff_hz) if drive_cutoff_hz is not None else fs / 6.0
-    x = lowpass(xr, fc, fs)
+    mod = kernels(backend)
+    x = lowpass(xr, fc, fs, backend=mod)
     vf = np.gradient(x, dt)
     a = np.gradient(vf, dt)
-    xd = lowpass(xr, fd, fs)
+    xd = lowpass(xr, fd, fs, backend=mod)
     v = np.gradient(xd, dt)
     # quantised encoders give velocity chatter at rest: zero what is below one count per
     # filter time constant, so that the bristles do not creep at standstill
     v = np.where(np.abs(v) < 0.5 * q * fd, 0.0, v)
-    fm_f = lowpass(fm, fc, fs)
+    fm_f = lowpass(fm, fc, fs, backend=mod)
     dfm = np.gradient(fm_f, dt)
     edge = max(round(3.0 * fs / fc), 5)
     mask = np.ones(n, dtype=bool)
@@ -427,7 +442,6 @@ def prepare(
     tt = tr - (rec.t[0] if t0 is None else t0)
     wn = fc / (0.5 * fs)
     sos = _butter(4, wn) if wn < 0.99 else None
-    mod = kernels(backend)
     x, xd, v, a, fm, fm_f = (np.ascontiguousarray(u, dtype=float) for u in (x, xd, v, a, fm, fm_f))
     tt = np.ascontiguousarray(tt, dtype=float)
     padlen = min(_PADLEN, n - 1)
@@ -512,15 +526,13 @@ def noise_floor(r: np.ndarray, sig: Signals) -> dict[str, float]:
     dict
         ``rms`` [N] (noise floor), ``n_eff``, ``bandwidth_hz`` (equivalent noise band).
     """
-    from scipy import stats
-
     y = r[sig.mask] - np.mean(r[sig.mask])
     n = y.size
     nper = int(min(n, max(256, 2 ** int(np.log2(max(n // 8, 256))))))
-    f, p = signal.welch(y, fs=sig.fs, nperseg=nper)
+    f, p = dsp.welch(y, sig.fs, nper)
     fc = sig.cutoff_hz
     sos = _butter(4, fc / (0.5 * sig.fs))
-    _, h = signal.sosfreqz(sos, worN=f, fs=sig.fs)
+    h = dsp.sosfreqz(sos, f, sig.fs)
     h2 = np.abs(h) ** 4  # filtfilt: squared magnitude, squared again for power
     sel = (f >= 0.25 * fc) & (f <= 0.9 * fc)
     if np.sum(sel) < 4:  # pragma: no cover - tiny records
@@ -538,7 +550,7 @@ def noise_floor(r: np.ndarray, sig: Signals) -> dict[str, float]:
     dof = 2.0 * segs * 0.9
     q = 0.3
     level = float(np.quantile(p[sel] / np.maximum(g[sel], 1e-12), q)
-                  / (stats.chi2.ppf(q, dof) / dof))
+                  / (dsp.chi2_ppf(q, dof) / dof))
     df = f[1] - f[0]
     b_eq = float(np.sum(h2) * df)  # one-sided equivalent noise bandwidth [Hz]
     var = level * float(np.sum(g) * df)
@@ -630,18 +642,16 @@ def hf_level(y: np.ndarray, fs: float, gain: Any = None) -> float | None:
     gain it went through, when given), from the median of its Welch spectrum between
     0.5 and 0.9 of the Nyquist frequency, above the motion's band, corrected for the
     chi-square spread of the estimate; None for under 256 samples or too few bins."""
-    from scipy import stats
-
     if y.size < 256:
         return None
     nper = int(min(1024, y.size))
-    f, p = signal.welch(y - np.mean(y), fs=fs, nperseg=nper)
+    f, p = dsp.welch(y - np.mean(y), fs, nper)
     band = (f > 0.25 * fs) & (f < 0.45 * fs)
     if np.sum(band) < 3:
         return None
     dof = 2.0 * max(1, 2 * y.size // nper - 1) * 0.9
     pb = p[band] if gain is None else p[band] / gain(f[band])
-    return float(np.median(pb) / (stats.chi2.ppf(0.5, dof) / dof))
+    return float(np.median(pb) / (dsp.chi2_ppf(0.5, dof) / dof))
 
 
 def force_noise_power(sig: Signals, weight: Any) -> float:
@@ -661,7 +671,7 @@ def filter_power(sig: Signals) -> tuple[np.ndarray, np.ndarray]:
     """Frequencies 0 to Nyquist (4001 points) and the power gain of the residual's
     zero-phase low-pass there (``|H|^4``: squared magnitude, applied twice)."""
     ff = np.linspace(0.0, 0.5 * sig.fs, 4001)
-    _, h = signal.sosfreqz(_butter(4, sig.cutoff_hz / (0.5 * sig.fs)), worN=ff, fs=sig.fs)
+    h = dsp.sosfreqz(_butter(4, sig.cutoff_hz / (0.5 * sig.fs)), ff, sig.fs)
     return ff, np.abs(h) ** 4
 
 

@@ -38,7 +38,8 @@ from ..vocabulary import (
     STRIBECK_SHAPE,
 )
 
-__all__ = ["COUPLING_SUBSTEPS", "InverseRecord", "parse_base_param",
+__all__ = ["COUPLING_SUBSTEPS", "InverseRecord", "filtfilt", "moving_median",
+           "parse_base_param",
            "position_sums"]
 
 #: Substeps multiplier of the load simulation behind a ``resonance``
@@ -176,6 +177,32 @@ class _Lowpass:
         self._run(ext, ext[0])
         ext.reverse()
         return np.array(ext[edge:edge + n])
+
+
+def filtfilt(y: Any, sos: Any, padlen: int) -> np.ndarray:
+    """``y`` through the sections ``sos`` forward and backward, odd extension of
+    ``min(padlen, len(y) - 1)`` samples (the low-pass of :meth:`InverseRecord.filt`):
+    the twin of :func:`lugre._native.filtfilt`."""
+    yy = _vec("y", y)
+    s = np.asarray(sos, dtype=float)
+    if s.ndim != 2:
+        raise InputError.at("sos", "must be a matrix with one row [b0, b1, b2, 1, a1, a2] "
+                            "per section")
+    return _Lowpass(s, int(padlen)).filtfilt(yy)
+
+
+def moving_median(y: Any, size: int) -> np.ndarray:
+    """The moving median of ``y`` over ``size`` samples centred on each (the element of
+    rank ``size // 2`` of the window), the ends extended by their edge values: the twin
+    of :func:`lugre._native.moving_median`."""
+    yy = _vec("y", y)
+    size = int(size)
+    if yy.size == 0 or size <= 1:
+        return yy.copy()
+    half = size // 2
+    ext = np.concatenate((np.full(half, yy[0]), yy, np.full(size - 1 - half, yy[-1])))
+    win = np.lib.stride_tricks.sliding_window_view(ext, size)
+    return np.partition(win, half, axis=-1)[:, half].copy()
 
 
 class InverseRecord:

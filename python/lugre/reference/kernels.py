@@ -12,9 +12,9 @@ from __future__ import annotations
 
 from .coupling import load_coupling
 from .friction import friction_force, stribeck
-from .inverse import InverseRecord, position_sums
+from .inverse import InverseRecord, filtfilt, moving_median, position_sums
 from .linear import irls_linear, irls_linear_grid
 from .servo import simulate, simulate_batch
 
-__all__ = ["InverseRecord", "friction_force", "irls_linear", "irls_linear_grid",
-           "load_coupling", "position_sums", "simulate", "simulate_batch", "stribeck"]
+__all__ = ["InverseRecord", "filtfilt", "friction_force", "irls_linear", "irls_linear_grid",
+           "load_coupling", "moving_median", "position_sums", "simulate", "simulate_batch", "stribeck"]
