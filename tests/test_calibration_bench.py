@@ -1,0 +1,71 @@
+"""The calibration bench's generator (benches/calibration_cases.py, a plant independent of
+the diagnosis) is sane: clean records diagnosed against their true model name nothing
+(on most of a handful), and an effect added at 3x the limit the report gives for that
+same record is named. Short records (4 s at 1 kHz) keep it under a minute."""
+
+from __future__ import annotations
+
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from lugre.diagnosis import diagnose
+from lugre.io import Recording
+from lugre.model import Model
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benches"))
+import calibration_cases as C
+
+SEEDS = (5, 6, 8, 9)
+
+
+def _case(seed: int) -> dict:
+    c = C.draw_case(seed, max_duration=4.0)
+    c["setup"]["rate_hz"] = 1000.0
+    return c
+
+
+def _diagnose(case: dict, rec: dict, hold: dict, model: dict) -> dict:
+    kind = case["truth"]["axis"].get("kind", "linear")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return diagnose(Recording(**rec, meta={"axis_kind": kind}), Model(model),
+                        holdout=Recording(**hold, meta={"axis_kind": kind})).to_dict()
+
+
+@pytest.fixture(scope="module")
+def clean():
+    cases = [_case(s) for s in SEEDS]
+    recs = C.records([(c, []) for c in cases])
+    return [(c, r, h, _diagnose(c, r, h, c["truth"])) for c, (r, h) in zip(cases, recs)]
+
+
+def test_clean_records_against_their_truth_name_nothing(clean):
+    named = [(c["seed"], c["family"], [f["effect"] for f in d["findings"]])
+             for c, _, _, d in clean]
+    assert sum(not n for _, _, n in named) >= len(clean) - 1, named
+
+
+def test_the_plant_holds_what_the_model_says(clean):
+    # against the true model the force residual is the current noise, no more: under
+    # twice its rms (in force; the diagnosis's filter takes some of it away)
+    for c, _, _, d in clean:
+        kf = c["truth"]["axis"].get("force_constant", c["truth"]["axis"].get("torque_constant"))
+        noise = c["setup"]["current_noise"] * kf
+        assert d["fit"]["after"]["rms_force"] < 2.0 * noise, (c["seed"], noise, d["fit"])
+
+
+@pytest.mark.parametrize("name", ["delay", "drag"])
+def test_an_effect_at_three_times_its_limit_is_named(clean, name):
+    case, rec, _, d = next((c, r, h, d) for c, r, h, d in clean if not d["findings"])
+    lim = {e["effect"]: e for e in d["could_not_reveal"]}
+    b = lim["delay/current_lag" if name == "delay" else name]["smallest"]
+    assert np.isfinite(b) and b > 0
+    eff = ({"effect": "delay", "seconds": 3 * b} if name == "delay"
+           else {"effect": "drag", "coefficient": 3 * b})
+    (r, h), = C.records([(case, [eff])])
+    np.testing.assert_array_equal(r["t"], rec["t"])  # the same record, the effect added
+    got = _diagnose(case, r, h, case["truth"])
+    assert name in [f["effect"] for f in got["findings"]], (case["seed"], eff, got["findings"])
