@@ -29,23 +29,28 @@ def test_mismatch_case(case):
     before = dg.fit["holdout_before"]["rms_force"]
     after = dg.fit["holdout_after"]["rms_force"]
     if truth:
-        assert after <= 0.7 * before
+        # measured 2026-11-26: after/before 0.016 (drag) to 0.091 (position friction);
+        # held to the worst measured + 6 points
+        assert after <= 0.15 * before
     else:
         assert after <= before * 1.001
+    # Tolerances: what the tool reaches on these records (measured 2026-11-26, the same
+    # on main and with the speed work), plus a stated margin: relative errors measured
+    # + 2 points (pitch and phase: + 0.2 % and + 0.02 rad; they are exact to 1e-4)
     for f, e in zip(dg.findings, truth):
-        if e["effect"] == "cogging":
-            assert f.parameters["pitch"] == pytest.approx(e["pitch"], rel=0.01)
-            assert f.parameters["amplitude"] == pytest.approx(e["amplitude"], rel=0.1)
-            assert f.parameters["phase"] == pytest.approx(e["phase"], abs=0.1)
+        if e["effect"] == "cogging":  # measured: pitch 0.007 %, amplitude 0.2 %, 0.001 rad
+            assert f.parameters["pitch"] == pytest.approx(e["pitch"], rel=0.002)
+            assert f.parameters["amplitude"] == pytest.approx(e["amplitude"], rel=0.025)
+            assert f.parameters["phase"] == pytest.approx(e["phase"], abs=0.02)
         p = f.parameters
-        if e["effect"] == "deadband":
-            assert p["current"] == pytest.approx(e["current"], rel=0.3)
-        if e["effect"] == "drag":
-            assert p["coefficient"] == pytest.approx(e["coefficient"], rel=0.3)
-        if e["effect"] == "stribeck_shape":
-            assert p["exponent"] == pytest.approx(e["exponent"], rel=0.2)
-        if e["effect"] == "resonance":
-            assert p["frequency"] == pytest.approx(e["frequency"], rel=0.15)
+        if e["effect"] == "deadband":  # measured 0.5 %
+            assert p["current"] == pytest.approx(e["current"], rel=0.025)
+        if e["effect"] == "drag":  # measured 0.06 %
+            assert p["coefficient"] == pytest.approx(e["coefficient"], rel=0.02)
+        if e["effect"] == "stribeck_shape":  # measured 7.3 %
+            assert p["exponent"] == pytest.approx(e["exponent"], rel=0.095)
+        if e["effect"] == "resonance":  # measured 2.8 %
+            assert p["frequency"] == pytest.approx(e["frequency"], rel=0.05)
             for k in ("frequency", "damping_ratio", "load_fraction"):
                 lo, hi = f.uncertainty[k]  # the held-out profile's interval holds the truth
                 assert lo <= e[k] <= hi, (k, lo, hi)
@@ -57,7 +62,7 @@ def test_mismatch_case(case):
             xs = np.array(e["positions"])
             s_true = np.array(e["scale"])
             s_est = np.interp(xs, pf["positions"], pf["scale"])
-            assert np.max(np.abs(s_est - s_true)) < 0.1
+            assert np.max(np.abs(s_est - s_true)) < 0.05  # measured 0.032, + 0.018
             lo, hi = f.where["position"]
             assert lo < e["generated_as"]["center"] < hi
 
@@ -72,7 +77,7 @@ def emps_laps():
 
 def test_emps_laps(emps_laps):
     _, _, base, dg = emps_laps
-    assert base.mass == pytest.approx(95.1, rel=0.05)
+    assert base.mass == pytest.approx(95.1, rel=0.02)  # measured 0.45 %, + 1.5 points
     before = dg.fit["holdout_before"]["nrmse_force"]
     after = dg.fit["holdout_after"]["nrmse_force"]
     assert before < 0.0408  # per-direction LuGre base beats the symmetric benchmark model
