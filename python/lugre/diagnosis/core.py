@@ -33,6 +33,7 @@ from .prepare import Prepared, prepare
 from .question import Questioned, contradicted_beside, question, without
 from .rebase import far_base
 from .report import Diagnosis
+from .search import release_columns
 from .select import select
 from .weigh import weigh
 
@@ -171,6 +172,7 @@ def _run(rec: Recording, model: Model, opts: Options) -> Diagnosis:
         q = question(prep, opts, search_kind)
         w = weigh(prep, q.model, q.r0, opts)
         sel = select(prep, w, opts)
+        release_columns(w.ctx)  # (hundreds of MB on a long record; read no more)
         j = refit(prep, w, sel, opts)
         later = _contradicted(prep, q, j, opts)
         if not later:

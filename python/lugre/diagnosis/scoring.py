@@ -126,8 +126,11 @@ class Scorer:
         # the samples read as one strided slice when they are evenly spaced (the usual
         # mask: the filter's edges left out): blocks of a column are then views
         self._span = None
+        self._rows = None
         if idx.size and np.all(np.diff(idx) == self.step):
             self._span = slice(int(idx[0]), int(idx[-1]) + 1, self.step)
+            if self.step > 1:  # and the same rows of columns kept at those rows only
+                self._rows = slice(int(idx[0]) // self.step, int(idx[-1]) // self.step + 1)
         self._products: dict[int, tuple[Any, tuple[np.ndarray, ...]]] = {}
         self._cross: dict[tuple[int, int], tuple[Any, Any, np.ndarray]] = {}
         edges = np.arange(self.K + 1) * nb
@@ -170,6 +173,8 @@ class Scorer:
         ``step``-th, as :func:`rows_of` keeps them.
         """
         if self.step > 1 and X.shape[0] == rows_count(self.n, self.step):
+            if self._rows is not None and X.flags.c_contiguous:  # a view: no copy
+                return self._stack(X[self._rows])
             return self._stack(X[self.idx // self.step])
         if X.shape[0] != self.n:
             raise ValueError(f"columns of {X.shape[0]} rows for a record of {self.n}")

@@ -23,7 +23,7 @@ from .scoring import (
     rows_of,
 )
 
-__all__ = ["forward_select", "make_term", "prefetch"]
+__all__ = ["forward_select", "make_term", "prefetch", "release_columns"]
 
 
 def make_term(c: Candidate, h: Any, ctx: Context, *, rows: bool = False) -> Term:
@@ -45,6 +45,18 @@ def make_term(c: Candidate, h: Any, ctx: Context, *, rows: bool = False) -> Term
             X = rows_of(X, step)
         cache[key] = X
     return Term(cand=c, h=h, X=X, prior=c.prior_tol(h, ctx), center=c.prior_center(h, ctx))
+
+
+def release_columns(ctx: Context) -> None:
+    """Drop the columns :func:`make_term` and :func:`prefetch` keep on ``ctx``.
+
+    The search profiles the same grids at every step and in its later runs (a refusal,
+    a look-alike), so the columns stay while it lasts; after it nothing reads them (the
+    joint refit builds its own), and on a million-sample record they are 650 MB
+    (every grid point's columns at the rows the scorers read, every other candidate's
+    whole). The terms chosen keep their own columns."""
+    for key in [k for k in ctx.extra if isinstance(k, tuple) and k[:1] == ("cache",)]:
+        del ctx.extra[key]
 
 
 def _column_key(c: Candidate, h: Any, step: int = 1) -> tuple[Any, ...]:
