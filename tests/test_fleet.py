@@ -157,18 +157,24 @@ def test_errors_are_the_generated_corrupt_files(first, fleet):
 
 
 def test_no_half_written_recording(first):
+    """Every stored recording has all its rows: its findings and both levels (when ok),
+    none when it failed; no row belongs to a recording that is not stored."""
     db = first / "fleet.duckdb"
-    for axis, rec, status, n in _rows(db, "SELECT axis, recording, status, n_findings "
-                                      "FROM recordings"):
-        found = _rows(db, f"SELECT count(*) FROM findings WHERE axis = '{axis}' AND "
-                      f"recording = '{rec}'")[0][0]
-        levels = _rows(db, f"SELECT count(*) FROM levels WHERE axis = '{axis}' AND "
-                       f"recording = '{rec}'")[0][0]
-        assert found == n
-        assert levels == (2 if status == "ok" else 0)
-    orphans = _rows(db, "SELECT count(*) FROM findings f ANTI JOIN recordings r "
-                    "USING (axis, recording)")[0][0]
-    assert orphans == 0
+    rows = _rows(db, """
+        SELECT r.axis, r.recording, r.status, r.n_findings,
+               (SELECT count(*) FROM findings f WHERE f.axis = r.axis
+                AND f.recording = r.recording),
+               (SELECT count(*) FROM levels l WHERE l.axis = r.axis
+                AND l.recording = r.recording)
+        FROM recordings r""")
+    assert len(rows) >= 200
+    for axis, rec, status, n, found, levels in rows:
+        assert found == n, (axis, rec)
+        assert levels == (2 if status == "ok" else 0), (axis, rec)
+    for table in ("findings", "levels", "limits"):
+        orphans = _rows(db, f"SELECT count(*) FROM {table} ANTI JOIN recordings "
+                        "USING (axis, recording)")[0][0]
+        assert orphans == 0
 
 
 def test_a_failed_write_leaves_nothing(tmp_path):
