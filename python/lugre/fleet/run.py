@@ -90,8 +90,10 @@ def _client(scheduler: str | None, workers: int) -> tuple[Any, Any]:
                              "cluster", name="--scheduler") from None
     import logging
 
+    # one thread per worker, the core's (rayon) pool included: N workers use N cores
     cluster = LocalCluster(n_workers=workers, processes=True, threads_per_worker=1,
-                           dashboard_address=None, silence_logs=logging.ERROR)
+                           dashboard_address=None, silence_logs=logging.ERROR,
+                           env={"RAYON_NUM_THREADS": "1"})
     return Client(cluster), cluster
 
 
