@@ -26,8 +26,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy import special
 
+from . import dsp
 from .candidates import Term
 
 __all__ = ["Evaluation", "Scorer", "accept", "accept_many", "block_evidence", "block_gains",
@@ -406,7 +406,7 @@ def compare(cur: Evaluation, new: Evaluation, s2: float) -> dict[str, float]:
     fit_gain = float((cur.sse_b.sum() - new.sse_b.sum()) / s2)
     prior_gain = float(cur.prior - new.prior)
     return {**out, "fit_gain": fit_gain, "prior_gain": prior_gain,
-            "p_prior": float(special.chdtrc(1, max(prior_gain, 0.0)))}  # stats.chi2.sf
+            "p_prior": dsp.chi2_sf1(max(prior_gain, 0.0))}  # stats.chi2.sf
 
 
 def block_gains(cur: Evaluation, new: Evaluation, s2: float) -> np.ndarray:
@@ -425,7 +425,7 @@ def block_evidence(d: np.ndarray) -> dict[str, Any]:
         p = 0.0 if d.mean() > 0 else 1.0
     else:
         t = float(d.mean() / (sd / np.sqrt(K)))
-        p = float(special.stdtr(K - 1, -t))  # stats.t.sf(t, K - 1), without its wrapper
+        p = float(dsp.t_cdf(K - 1, -t))  # stats.t.sf(t, K - 1)
     pos = float(d[d > 0].sum())
     neg = float(-d[d < 0].sum())
     return {"gain": float(d.sum()), "t": t, "p": p, "positive": int(np.sum(d > 0)),
@@ -481,7 +481,7 @@ def accept_many(d: np.ndarray, gain: np.ndarray, *, alpha: float,
     mean = d.mean(-1)
     with np.errstate(divide="ignore", invalid="ignore"):
         t = np.where(sd > 0, mean / (sd / np.sqrt(K)), np.where(mean > 0, np.inf, 0.0))
-    p = np.where(sd > 0, special.stdtr(K - 1, -np.where(np.isfinite(t), t, 0.0)),
+    p = np.where(sd > 0, dsp.t_cdf(K - 1, -np.where(np.isfinite(t), t, 0.0)),
                  np.where(mean > 0, 0.0, 1.0))
     pos = np.where(d > 0, d, 0.0).sum(-1)
     neg = -np.where(d < 0, d, 0.0).sum(-1)
