@@ -34,17 +34,23 @@ class _Secant(Candidate):
     def from_secant(self, h: Any, b: float) -> Any:
         return h
 
+    def _signals(self, ctx: Context) -> Signals:
+        """The signals the columns are computed on: the record's own."""
+        return ctx.sig
+
     def _r_base(self, ctx: Context) -> np.ndarray:
-        key = ("r_base", id(ctx.model))
+        sig = self._signals(ctx)
+        key = ("r_base", id(ctx.model), id(sig))
         if key not in ctx.extra:
-            ctx.extra[key] = R.residual(ctx.model, ctx.sig)
+            ctx.extra[key] = R.residual(ctx.model, sig)
         return ctx.extra[key]
 
     def _with(self, h: Any, ctx: Context) -> Model:
         return ctx.model.replace(effects=list(ctx.model.effects) + [self.effect_at(h)])
 
     def columns(self, h: Any, ctx: Context) -> np.ndarray:
-        return (self._r_base(ctx) - R.residual(self._with(h, ctx), ctx.sig))[:, None]
+        return (self._r_base(ctx) - R.residual(self._with(h, ctx), self._signals(ctx))
+                )[:, None]
 
     def columns_many(self, hs: list[Any], ctx: Context) -> list[np.ndarray] | None:
         """The columns of several grid points at once (the kernel runs them in
@@ -52,7 +58,7 @@ class _Secant(Candidate):
         if type(self).columns is not _Secant.columns:
             return None
         r0 = self._r_base(ctx)
-        rs = ctx.sig.kernel.residuals([self._with(h, ctx) for h in hs])
+        rs = self._signals(ctx).kernel.residuals([self._with(h, ctx) for h in hs])
         return [(r0 - rs[:, j])[:, None] for j in range(len(hs))]
 
     def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
