@@ -392,7 +392,6 @@ def _fit_and_write(args: argparse.Namespace, rec: Any, effects: list[str]) -> in
     """``lugre fit`` once the recording is read, in the units of its axis."""
     from . import units as U
     from .diagnosis import evaluate, fit_inverse_dynamics, fit_model
-    from .diagnosis.fitreport import identification
     from .model import save_model
 
     if rec.F is None and args.force_constant is None:
@@ -410,12 +409,14 @@ def _fit_and_write(args: argparse.Namespace, rec: Any, effects: list[str]) -> in
         with pr.step("fitting mass and friction to the record"
                      + (f" with {', '.join(effects)}" if effects else "")):
             model, fit = fit_model(rec, effects=effects, mass=args.mass, force_constant=kf)
-    nrmse = evaluate(rec, model)["nrmse_force"]
+    ident = model.to_dict().get("identification") or {}
+    nrmse = ident.get("nrmse_force")
+    if nrmse is None:
+        nrmse = evaluate(rec, model)["nrmse_force"]
     print(f"{U.force_words()} residual {100 * nrmse:.2f} % of the motor {U.force_words()} "
           "(rms)" + (" after the inverse-dynamics least squares alone" if fit is None else ""))
     if fit is not None:
         _print_fit(fit, effects)
-        model = model.replace(identification=identification(fit, model, nrmse))
     _print_model(model, rec.F is None)
     page = None
     if args.html:

@@ -13,7 +13,8 @@ from ..vocabulary import GRAVITY, NAMES, kind
 from . import residual as R
 from .basefit import fit_base, identify
 from .core import diagnose
-from .evaluation import as_recording
+from .evaluation import as_recording, evaluate
+from .fitreport import identification
 from .options import IDENTIFY_TOLERANCE
 
 __all__ = ["fit_model"]
@@ -82,7 +83,7 @@ def fit_model(
     else:
         res = _gravity_set_aside(res)
     if not wanted:
-        return res.model, res
+        return _identified(rec, res.model, res, cutoff_hz, backend), res
     dg = diagnose(rec, res.model, candidates=wanted, free_mass=mass is None,
                   cutoff_hz=cutoff_hz, screw_lead=screw_lead, closed_loop=False,
                   tolerance=IDENTIFY_TOLERANCE, backend=backend)
@@ -90,7 +91,8 @@ def fit_model(
     if mass is not None:
         model = model.with_axis(mass=float(mass))
     if not dg.findings:
-        return res.model, replace(res, diagnosis=dg)
+        return (_identified(rec, res.model, res, cutoff_hz, backend),
+                replace(res, diagnosis=dg))
     # the base fitted again with the effects found held in it: the search refits the
     # levels only near the base it was given, which the effects had pulled astray (a
     # cogging on the slow samples doubles a hump)
@@ -99,7 +101,17 @@ def fit_model(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         final = fit_base(sig, model, free_mass=mass is None)  # (model: the first start)
-    return final.model, replace(final, diagnosis=dg)
+    return (_identified(rec, final.model, final, cutoff_hz, backend),
+            replace(final, diagnosis=dg))
+
+
+def _identified(rec: Any, model: Model, fit: Any, cutoff_hz: float | None,
+                backend: Any) -> Model:
+    """The model with its ``identification`` section (the fit against the record's
+    noise floor, every parameter with its interval): the file says that ``lugre fit``
+    made it, so that ``diagnose`` takes its base as an estimate from the record."""
+    nrmse = evaluate(rec, model, cutoff_hz=cutoff_hz, backend=backend)["nrmse_force"]
+    return model.replace(identification=identification(fit, model, nrmse))
 
 
 def _gravity_set_aside(res: Any) -> Any:

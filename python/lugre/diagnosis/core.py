@@ -119,7 +119,7 @@ def diagnose(
                    min_gain=min_gain, closed_loop=closed_loop,
                    candidates=None if candidates is None else tuple(candidates),
                    screw_lead=screw_lead, free_mass=free_mass, tolerance=tolerance,
-                   backend=backend)
+                   backend=backend, presliding_fitted="sigma1" in fitted)
     with warnings.catch_warnings(), U.axis(model.kind):  # (the trial models' warnings)
         warnings.simplefilter("ignore", PassivityWarning)
         dg = _run(rec, model, opts)

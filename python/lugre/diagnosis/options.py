@@ -49,6 +49,7 @@ class Options:
     candidates: tuple[str, ...] | None = None
     screw_lead: float | None = None
     free_mass: bool = False
+    presliding_fitted: bool = False
     tolerance: float = 1.0
     backend: Any = "core"
     question: bool = True
