@@ -293,12 +293,13 @@ def summarise(rows: list[dict[str, Any]], args: dict[str, Any]) -> tuple[dict[st
     any_p = sum(1 for r in ok if r["trials_p_under_alpha"] > 0)
     over = sum(1 for r in ok if r.get("accepted_overwhelming", 0) > 0)
     by_effect = Counter(f["effect"] for r in ff for f in r["findings"])
-    fams: dict[str, list[int]] = defaultdict(lambda: [0, 0])
+    fams: dict[str, list[int]] = defaultdict(lambda: [0, 0, 0])
     for r in ok:
         parts = r["family"].split("/")
-        for key in (parts[0], parts[1], parts[2], parts[3]):
+        for key in (*parts[:4], f"record at {parts[4]}"):
             fams[key][0] += 1
             fams[key][1] += bool(r["findings"])
+            fams[key][2] += any(not is_mass_correction(r, f) for f in r["findings"])
     S: dict[str, Any] = {
         "args": args,
         "clean": {"records": len(clean), "diagnosed": n, "errors": len(clean) - n,
@@ -312,7 +313,8 @@ def summarise(rows: list[dict[str, Any]], args: dict[str, Any]) -> tuple[dict[st
                   "records_accepted_overwhelming": over,
                   "mean_trials": float(np.mean([r["trials"] for r in ok])) if ok else None,
                   "named_effects": dict(by_effect),
-                  "by_family": {f: {"records": v[0], "with_finding": v[1]}
+                  "by_family": {f: {"records": v[0], "with_finding": v[1],
+                                    "besides_mass_correction": v[2]}
                                 for f, v in sorted(fams.items())},
                   "false_findings": [{"seed": r["seed"], "family": r["family"],
                                       "effects": [f["effect"] for f in r["findings"]],
@@ -379,9 +381,10 @@ def markdown(S: dict[str, Any]) -> str:
            "Named on clean records: " + (", ".join(f"{k} {v}" for k, v in
                                                     sorted(c["named_effects"].items()))
                                          or "nothing"), "",
-           "| family | records | with a finding |", "|---|---|---|"]
-    out += [f"| {f} | {v['records']} | {v['with_finding']} |"
-            for f, v in c["by_family"].items()]
+           "| family | records | with a finding | besides base mass corrections |",
+           "|---|---|---|---|"]
+    out += [f"| {f} | {v['records']} | {v['with_finding']} | "
+            f"{v['besides_mass_correction']} |" for f, v in c["by_family"].items()]
     out += ["", ("Detection against the reported limit (named / run; skipped = limit "
             "infinite or out of range):"), "",
             ("| effect | 0.5x | 1x | 2x | anything named at 0.5x / 1x / 2x | skipped "
