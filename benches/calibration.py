@@ -108,9 +108,11 @@ def _mass_error(case: dict[str, Any]) -> float:
     return float(g(case["truth"]) - g(case["believed"]))
 
 
-def clean_batch(seeds: list[int], max_duration: float) -> list[dict[str, Any]]:
+def clean_batch(seeds: list[int], max_duration: float, min_duration: float = 3.0
+                ) -> list[dict[str, Any]]:
     """Simulate a batch of clean cases as lanes of one run, diagnose each."""
-    cases = [C.draw_case(s, max_duration=max_duration) for s in seeds]
+    cases = [C.draw_case(s, max_duration=max_duration, min_duration=min_duration)
+             for s in seeds]
     out = []
     try:
         recs = C.records([(c, []) for c in cases])
@@ -224,9 +226,10 @@ def named(effect: str, findings: list[dict[str, Any]]) -> bool:
     return effect in names or (effect == "mass" and "inertia" in names)
 
 
-def sweep_case(seed: int, base: dict[str, Any], max_duration: float) -> list[dict[str, Any]]:
+def sweep_case(seed: int, base: dict[str, Any], max_duration: float,
+               min_duration: float = 3.0) -> list[dict[str, Any]]:
     """One clean record regenerated with each effect at each multiple of its limit."""
-    case = C.draw_case(seed, max_duration=max_duration)
+    case = C.draw_case(seed, max_duration=max_duration, min_duration=min_duration)
     limits = {c["effect"]: c for c in base["could_not_reveal"]}
     x = np.array(base["x_range"])  # the clean record's positions: min, mean, max
     rotary = case["truth"]["axis"].get("kind") == "rotary"
@@ -408,11 +411,11 @@ def markdown(S: dict[str, Any]) -> str:
 
 # ------------------------------------------------------------------------ main
 
-def _clean_job(args: tuple[list[int], float]) -> list[dict[str, Any]]:
+def _clean_job(args: tuple[list[int], float, float]) -> list[dict[str, Any]]:
     return clean_batch(*args)
 
 
-def _sweep_job(args: tuple[int, dict[str, Any], float]) -> list[dict[str, Any]]:
+def _sweep_job(args: tuple[int, dict[str, Any], float, float]) -> list[dict[str, Any]]:
     try:
         return sweep_case(*args)
     except Exception as e:  # noqa: BLE001
@@ -429,6 +432,8 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--batch", type=int, default=12, help="clean cases simulated together")
     ap.add_argument("--max-duration", type=float, default=60.0)
+    ap.add_argument("--min-duration", type=float, default=3.0,
+                    help="clip the drawn durations from below (long-record runs)")
     ap.add_argument("--sweep-max-duration", type=float, default=20.0)
     ap.add_argument("--summarise", action="store_true",
                     help="only rewrite the tables from OUT_DIR/calibration.json")
@@ -446,9 +451,11 @@ def main() -> None:
     args = {**vars(a), "command": "python benches/calibration.py " + " ".join(sys.argv[1:])}
     seeds = list(range(a.seed, a.seed + a.clean))
     # cases of similar length run together (a lane runs as long as the batch's longest)
-    dur = {s: C.draw_case(s, max_duration=a.max_duration)["setup"]["duration"] for s in seeds}
+    dur = {s: C.draw_case(s, max_duration=a.max_duration, min_duration=a.min_duration)
+           ["setup"]["duration"] for s in seeds}
     order = sorted(seeds, key=lambda s: dur[s])
-    batches = [(order[j:j + a.batch], a.max_duration) for j in range(0, len(order), a.batch)]
+    batches = [(order[j:j + a.batch], a.max_duration, a.min_duration)
+               for j in range(0, len(order), a.batch)]
     rows: list[dict[str, Any]] = []
     t0 = time.time()
 
@@ -475,7 +482,7 @@ def main() -> None:
     half = (a.sweep + 1) // 2
     pick = rot[:half] + lin[:a.sweep - min(half, len(rot))]
     pick = pick + [r for r in ok if r not in pick][:a.sweep - len(pick)]
-    jobs = [(r["seed"], r, a.max_duration) for r in pick]
+    jobs = [(r["seed"], r, a.max_duration, a.min_duration) for r in pick]
     for done, res in enumerate(mapper(_sweep_job, jobs), 1):
         rows += res
         print(f"[{time.time() - t0:6.0f} s] sweep {done}/{len(jobs)} (seed {res[0]['seed']})",

@@ -63,10 +63,12 @@ def _logu(rng: np.random.Generator, lo: float, hi: float) -> float:
     return float(np.exp(rng.uniform(math.log(lo), math.log(hi))))
 
 
-def draw_case(seed: int, *, max_duration: float = 60.0, family: str | None = None
-              ) -> dict[str, Any]:
+def draw_case(seed: int, *, max_duration: float = 60.0, family: str | None = None,
+              min_duration: float = 3.0) -> dict[str, Any]:
     """A case from its seed: ``{"seed", "family", "truth" (model, no effects),
-    "believed", "setup"}``. ``family`` ``"linear"``/``"rotary"`` forces the axis kind."""
+    "believed", "setup"}``. ``family`` ``"linear"``/``"rotary"`` forces the axis kind;
+    the drawn duration is clipped to ``[min_duration, max_duration]`` (nothing else of
+    the draw changes)."""
     rng = np.random.default_rng([27, seed])
     rotary = (rng.uniform() < 0.4) if family is None else family == "rotary"
     if rotary:
@@ -113,7 +115,7 @@ def draw_case(seed: int, *, max_duration: float = 60.0, family: str | None = Non
                                         "sigma1": sigma1, **sets},
              "effects": [], "controller": ctrl}
     duration = (_logu(rng, 3.0, 20.0) if rng.uniform() < 0.8 else _logu(rng, 20.0, 60.0))
-    duration = float(min(duration, max_duration))
+    duration = float(min(max(duration, min_duration), max_duration))
     rec_rate = float(rng.choice(RECORD_RATES, p=[0.12, 0.14, 0.3, 0.2, 0.14, 0.1]))
     kind = str(rng.choice(TRAJECTORIES))
     noise_kind = "white" if rng.uniform() < 0.5 else "coloured"
