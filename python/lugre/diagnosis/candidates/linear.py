@@ -11,7 +11,7 @@ from ...vocabulary import DRAG, LOAD_FRICTION, MASS, OFFSET, SPRING
 from .. import base as B
 from .. import residual as R
 from .base import Candidate, Context, FindingView, Said, by
-from .probe import hide, two_ways, under
+from .probe import FixedInPosition, hide, two_ways, under
 
 __all__ = ["ASYMMETRY_EXPERIMENT", "FORCE_FRICTION_EXPERIMENT", "Drag", "Mass", "Offset",
            "Spring"]
@@ -60,7 +60,7 @@ class Offset(Candidate):
         return Said(evidence=txt, alternatives=() if alt is None else (alt,))
 
 
-class Spring(Candidate):
+class Spring(FixedInPosition, Candidate):
     effect = SPRING
     supersedes = (OFFSET,)
     signature = "a force linear in position, the same in both directions"

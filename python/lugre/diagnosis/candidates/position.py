@@ -11,12 +11,12 @@ from ... import units as U
 from ...vocabulary import COGGING, GRAVITY, OFFSET, POSITION_FRICTION
 from ..residual import position_sums
 from .base import Candidate, Context, by
-from .probe import hide, share, under
+from .probe import FixedInPosition, hide, share, under
 
 __all__ = ["Cogging", "Gravity", "PositionFriction"]
 
 
-class Gravity(Candidate):
+class Gravity(FixedInPosition, Candidate):
     """A load's weight on a joint, ``torque*sin(x + phase)``: two columns, ``sin(x)``
     and ``cos(x)``. One turn is known, so a record that spans a fraction of a turn still
     shows the curvature that tells it from a spring and an offset (which it contains)."""
@@ -54,7 +54,7 @@ class Gravity(Candidate):
                     experiment="slow moves over a large part of a turn in both directions")
 
 
-class Cogging(Candidate):
+class Cogging(FixedInPosition, Candidate):
     effect = COGGING
     chooses = True
     signature = "a force periodic in position, independent of the direction of motion"

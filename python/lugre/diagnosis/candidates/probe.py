@@ -104,3 +104,63 @@ def hide(effect: str, b: float, unit: str, what: str, rng: Any = None,
 def amps(a: float) -> str:
     """A current in words, mA below one ampere."""
     return f"{a * 1e3:.3g} mA" if abs(a) < 1 else f"{a:.3g} A"
+
+
+#: A force fixed in position read where the axis hardly accelerates and where it
+#: accelerates hard: readings apart by more than this share of the larger (or of
+#: opposite signs) are no such force (an inertia varying by 30 % over a joint's turn
+#: read its weight-like part 0.56 and 0.92).
+STEADY_APART = 0.3
+
+
+def same_at_any_acceleration(scorer: Any, terms: list[Any], k: int, ev: Any,
+                             ctx: Any) -> dict[str, Any] | None:
+    """Is the position-fixed force ``terms[k]`` (a spring, a weight, a cogging) the same
+    where the axis hardly accelerates and where it accelerates hard? Such a force
+    depends on the position alone; an inertia that changes with the position (a joint
+    with the arm behind it) adds a force periodic in position that grows with the
+    acceleration, which a weight or a spring fits in part. The term, as fitted (its
+    columns combined by its coefficients, so that one coefficient of 1 stands for it),
+    is refitted jointly with the base and the other terms on the samples under and over
+    the median acceleration; when both determine it and differ by more than four combined
+    standard errors and by more than 30 % of the larger (or in sign), it is no force
+    fixed in position. Returns the figures, or None when the record
+    cannot tell."""
+    from dataclasses import replace
+
+    m = scorer.mask
+    j = start_of(scorer, terms, k)
+    t = terms[k]
+    col = t.X @ ev.beta[j:j + t.X.shape[1]]
+    if not np.any(col[m]):
+        return None
+    tt = list(terms[:k]) + [replace(t, X=col[:, None], prior=None, center=None)] + list(
+        terms[k + 1:])
+    acc = np.abs(ctx.sig.a)
+    cut = float(np.median(acc[m]))
+    out = two_ways(scorer, tt, k, scorer.evaluate(tt),
+                   {"calm": m & (acc <= cut), "accelerating": m & (acc > cut)})
+    if out is None:
+        return None
+    a, b = out["calm"], out["accelerating"]
+    unlike = a * b <= 0 or abs(a - b) > STEADY_APART * max(abs(a), abs(b))
+    out["not_fixed"] = bool(out.pop("apart") and unlike)
+    return out
+
+
+class FixedInPosition:
+    """The check of a force fixed in position (:func:`same_at_any_acceleration`)."""
+
+    check_rank = 1
+
+    def check(self, scorer: Any, terms: list[Any], k: int, ev: Any, ctx: Any
+              ) -> dict[str, Any] | None:
+        return same_at_any_acceleration(scorer, terms, k, ev, ctx)
+
+    def refusal(self, chk: dict[str, Any]) -> str | None:
+        if not chk["not_fixed"]:
+            return None
+        return (f"it reads {chk['calm']:.2g} of its size where the axis hardly "
+                f"accelerates and {chk['accelerating']:.2g} where it accelerates hard: a "
+                "force fixed in position is the same at any acceleration (an inertia that "
+                "changes with the position is not)")
