@@ -148,14 +148,29 @@ def _distribute(todo: list[tuple[Axis, Path, str]], models: dict[str, Any], stor
         summary.workers = len(client.scheduler_info().get("workers", {})) or workers
         dicts = {name: m.to_dict() for name, m in models.items()}
         futures = {}
+
+        def submit(axis: str, path: str, stamp: str, attempt: int) -> Any:
+            fut = client.submit(diagnose_file, axis, path, dicts[axis], stamp,
+                                key=f"lugre-fleet-{axis}/{Path(path).name}-{stamp}-{attempt}",
+                                pure=False, retries=RETRIES)
+            futures[fut] = (axis, path, stamp, attempt)
+            return fut
+
         for ax, p, stamp in todo:
-            fut = client.submit(diagnose_file, ax.name, str(p), dicts[ax.name], stamp,
-                                key=f"lugre-fleet-{ax.name}/{p.name}-{stamp}", pure=False,
-                                retries=RETRIES)
-            futures[fut] = (ax.name, str(p), stamp)
+            submit(ax.name, str(p), stamp, 0)
         counter = _Counter(len(todo), progress)
-        for fut in as_completed(list(futures)):
-            result = _result(fut, *futures[fut])
+        pending = as_completed(list(futures))
+        for fut in pending:
+            axis, path, stamp, attempt = futures.pop(fut)
+            result = _result(fut, axis, path, stamp)
+            if result.get("transient") and attempt < RETRIES:
+                # (the task raised outside the diagnosis, which returns its own errors:
+                # the cluster's machinery, e.g. a worker's event loop torn down as it
+                # died; the recording is diagnosed again)
+                pending.add(submit(axis, path, stamp, attempt + 1))
+                fut.release()
+                continue
+            result.pop("transient", None)
             store.put(result)
             summary.stored += 1
             if result["status"] != "ok":
@@ -182,7 +197,10 @@ def _result(fut: Any, axis: str, path: str, stamp: str) -> dict[str, Any]:
                     "killed): check the recording's size and the workers' memory")
         else:
             text = f"{path}: the diagnosis failed ({type(e).__name__}: {e})"
-        return failed(axis, path, stamp, " ".join(text.split()))
+        out = failed(axis, path, stamp, " ".join(text.split()))
+        # (the diagnosis returns its own errors: a raise is the cluster's, worth a retry)
+        out["transient"] = not isinstance(e, KilledWorker)
+        return out
 
 
 class _Counter:
