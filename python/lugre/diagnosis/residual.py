@@ -224,13 +224,23 @@ class Signals:
         return int(self.t.size)
 
     def with_drive(self, v: np.ndarray) -> Signals:
-        """A copy whose bristles are driven by the velocity ``v`` (its kernel rebuilt:
-        the signals are frozen, the kernel holds its own copy of them)."""
-        v = np.ascontiguousarray(v, dtype=float)
+        """A copy whose bristles are driven by the velocity ``v``."""
+        return self._rebuilt(v=np.ascontiguousarray(v, dtype=float))
+
+    def with_force(self, f: np.ndarray) -> Signals:
+        """A copy whose motor force is ``f`` (taken as low-passed already), the rest of
+        the record as it is."""
+        f = np.ascontiguousarray(f, dtype=float)
+        return self._rebuilt(fm=f, fm_f=f)
+
+    def _rebuilt(self, **arrays: np.ndarray) -> Signals:
+        """A copy with ``arrays`` replaced and its kernel rebuilt (the signals are
+        frozen, the kernel holds its own copy of them)."""
+        new = replace(self, **arrays)
         sos, padlen = self.info["filter"]
-        kernel = type(self.kernel)(self.t, self.x, self.info["x_drive"], v, self.a, self.fm,
-                                   self.fm_f, self.dt, sos, padlen)
-        return replace(self, v=v, kernel=kernel)
+        kernel = type(self.kernel)(new.t, new.x, new.info["x_drive"], new.v, new.a, new.fm,
+                                   new.fm_f, new.dt, sos, padlen)
+        return replace(new, kernel=kernel)
 
 
 def check_recording(rec: Recording, model: Model | None = None) -> None:

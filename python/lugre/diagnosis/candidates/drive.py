@@ -5,7 +5,6 @@ transmission carries."""
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -248,7 +247,7 @@ class LoadFriction(_Secant):
         key = ("needed_force", id(ctx.model))
         if key not in ctx.extra:
             sig = ctx.sig
-            ctx.extra[key] = _with_force(sig, sig.fm_f - R.residual(ctx.model, sig))
+            ctx.extra[key] = sig.with_force(sig.fm_f - R.residual(ctx.model, sig))
         return ctx.extra[key]
 
 
@@ -300,16 +299,6 @@ class LoadFriction(_Secant):
                     f"{U.force_words()} {under(100 * b, '{:.2g} %')} of it",
                     experiment=("moves at one speed under different loads or "
                                 "accelerations"))
-
-
-def _with_force(sig: Signals, f: np.ndarray) -> Signals:
-    """A copy of the signals whose motor force is ``f`` (taken as low-passed already),
-    its kernel rebuilt, the rest of the record as it is."""
-    f = np.ascontiguousarray(f, dtype=float)
-    sos, padlen = sig.info["filter"]
-    kernel = type(sig.kernel)(sig.t, sig.x, sig.info["x_drive"], sig.v, sig.a, f, f,
-                              sig.dt, sos, padlen)
-    return replace(sig, fm=f, fm_f=f, kernel=kernel)
 
 
 #: The cogging's look-alike among these: told apart by how it scales with the current.

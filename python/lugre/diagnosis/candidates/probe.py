@@ -3,6 +3,7 @@ reversals of the motion, and the words of what a record could hide."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -126,7 +127,6 @@ def same_at_any_acceleration(scorer: Any, terms: list[Any], k: int, ev: Any,
     standard errors and by more than 30 % of the larger (or in sign), it is no force
     fixed in position. Returns the figures, or None when the record
     cannot tell."""
-    from dataclasses import replace
 
     m = scorer.mask
     j = start_of(scorer, terms, k)
