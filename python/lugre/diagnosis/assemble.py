@@ -95,7 +95,7 @@ def _unexplained(prep: Prepared, w: Weighing, sel: Selection, ev: Evidence,
     if noise_after["rms"] > EXCESS_FLOOR * expected["rms"] > 0:
         excess = {"floor": noise_after["rms"], "expected": expected["rms"]}
     un = V.unexplained(ev.r1, sig, min(w.noise["rms"], noise_after["rms"]),
-                       located["after"], fit["after"], sel.refused.get(TIMING),
+                       located["after"], fit["after"], sel.own_check(TIMING),
                        ev.joint.mass_ways, excess)
     if un is not None and ev.resembles:
         un["resembles"] = ev.resembles

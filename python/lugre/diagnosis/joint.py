@@ -267,4 +267,4 @@ def refit(prep: Prepared, w: Weighing, sel: Selection, opts: Options) -> Joint:
     if weak:
         j = rf.drop(weak, j)
     j = _noise_made(rf, prep, sel, j)
-    return replace(j, mass_ways=_mass_still(rf, j, sel.refused.get(E.Mass.effect)))
+    return replace(j, mass_ways=_mass_still(rf, j, sel.own_check(E.Mass.effect)))

@@ -399,9 +399,11 @@ def compare(cur: Evaluation, new: Evaluation, s2: float) -> dict[str, float]:
     dict
         ``gain`` (score gain), ``t`` and ``p`` (one-sided t-test over the blocks),
         ``positive`` (blocks with a gain), ``blocks``, ``ratio`` (sum of positive over sum of
-        negative block gains).
+        negative block gains), ``d`` (the per-block gains).
     """
-    out = block_evidence(block_gains(cur, new, s2))
+    d = block_gains(cur, new, s2)
+    out = block_evidence(d)
+    out["d"] = d
     out["gain"] = float(cur.score - new.score)
     fit_gain = float((cur.sse_b.sum() - new.sse_b.sum()) / s2)
     prior_gain = float(cur.prior - new.prior)

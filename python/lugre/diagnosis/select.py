@@ -16,6 +16,7 @@ from . import base as B
 from . import candidates as E
 from .candidates import Term
 from .options import RIVAL_SHARE, Options
+from .partial import partial_refusal
 from .prepare import Prepared
 from .refit import refine, split
 from .scoring import Evaluation, told_apart
@@ -44,6 +45,13 @@ class Selection:
     intervals: dict[str, dict[str, float]]
     cands: list[E.Candidate]
     held_kinds: set[str]
+
+    def own_check(self, effect: str) -> dict[str, Any] | None:
+        """The figures of the physics check that refused ``effect`` (a lag at the
+        reversals only, a mass that differs speeding up and braking); None when that
+        check did not refuse it."""
+        chk = self.refused.get(effect)
+        return None if chk is None or chk.get("check") == "partial" else chk
 
 
 def candidates(w: Weighing, opts: Options) -> tuple[list[E.Candidate], set[str]]:
@@ -79,7 +87,8 @@ def _refuse(w: Weighing, bs: BaseSet, cands: list[E.Candidate], opts: Options,
     """A named term whose physics fails its own check is refused, and the search runs
     again without it: a lag that fits the reversals but not the motion between them is
     lost motion, not timing; a mass that differs speeding up and braking is no payload.
-    The rest is described instead."""
+    The rest is described instead. So is a term taken on the confined route that leaves
+    most of the mismatch where it gains (:mod:`~lugre.diagnosis.partial`)."""
     terms, ev, log = found
     run = _searcher(w, bs.scorer, opts)
     refused: dict[str, dict[str, Any]] = {}
@@ -87,26 +96,34 @@ def _refuse(w: Weighing, bs: BaseSet, cands: list[E.Candidate], opts: Options,
                      key=lambda c: c.check_rank)
     # (after a refusal the search runs again and may name a term checked before: every
     # check is read again until none refuses)
-    again = True
-    while again:
-        again = False
-        for c in checked:
-            effect = c.effect
-            k = next((k for k, t in enumerate(terms) if t.effect == effect and not t.minor),
-                     None)
-            if effect in refused or k is None:
-                continue
-            chk = terms[k].cand.check(bs.scorer, terms, k, ev, w.ctx)
-            why = None if chk is None else c.refusal(chk)
-            if chk is None or why is None:
-                continue
-            refused[effect] = chk
-            _not_named(log, effect, why)
-            terms, ev, log2 = run([c for c in cands if c.effect not in refused])
-            log += log2
-            again = True
-            break
-    return terms, ev, log, refused
+    while True:
+        out = _own_check(w, bs, checked, refused, terms, ev) or partial_refusal(
+            bs.scorer, [t for t in terms if t.effect not in refused], ev, log,
+            w.noise["rms"])
+        if out is None:
+            return terms, ev, log, refused
+        effect, chk, why = out
+        refused[effect] = chk
+        _not_named(log, effect, why)
+        terms, ev, log2 = run([c for c in cands if c.effect not in refused])
+        log += log2
+
+
+def _own_check(w: Weighing, bs: BaseSet, checked: list[E.Candidate],
+               refused: dict[str, dict[str, Any]], terms: list[Term], ev: Evaluation
+               ) -> tuple[str, dict[str, Any], str] | None:
+    """The first named term that its own physics' check refuses: ``(effect, figures,
+    why)``, or None."""
+    for c in checked:
+        k = next((k for k, t in enumerate(terms) if t.effect == c.effect and not t.minor),
+                 None)
+        if c.effect in refused or k is None:
+            continue
+        chk = terms[k].cand.check(bs.scorer, terms, k, ev, w.ctx)
+        why = None if chk is None else c.refusal(chk)
+        if chk is not None and why is not None:
+            return c.effect, chk, why
+    return None
 
 
 def _exact_sse(prep: Prepared, w: Weighing, bs: BaseSet, opts: Options, tt: list[Term],
