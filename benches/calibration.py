@@ -95,7 +95,7 @@ def _diagnose(case: dict[str, Any], rec: dict[str, np.ndarray], hold: dict[str, 
         "trials_p_under_alpha": sum(p < ALPHA for p in ps),
         "accepted_overwhelming": sum(1 for tr in trials if tr.get("accepted")
                                      and not tr.get("p", 1.0) < ALPHA),
-        "could_not_reveal": [{k: c.get(k) for k in ("effect", "smallest", "unit", "text")}
+        "could_not_reveal": [{k: c.get(k) for k in ("effect", "smallest", "unit", "text", "range")}
                              for c in d.get("could_not_reveal") or []],
         "nrmse_before": d["fit"]["before"]["nrmse_force"],
         "nrmse_after": d["fit"]["after"]["nrmse_force"],
@@ -200,6 +200,15 @@ def sized(name: str, mult: float, limits: dict[str, dict[str, Any]], case: dict[
         # one side at every multiple: below 2 on odd seeds, unless 2x the limit would
         # take the exponent under 0.3
         side = 1.0 if case["seed"] % 2 == 0 or 2.0 - 2.0 * float(b) < 0.3 else -1.0
+        rng_ = lim.get("range")
+        if rng_:  # the report gives each side's limit: the side's own margin
+            lo, hi = rng_
+            edge = hi if side > 0 else lo
+            if edge is None:
+                return None, "limit not finite on this side"
+            s = mult * abs(float(edge) - 2.0)
+            if side < 0 and 2.0 - s < 0.3:
+                return None, "exponent under 0.3"
         return {"effect": "stribeck_shape", "exponent": 2.0 + side * s}, ""
     if name == "resonance":
         fr = _freq_range(lim.get("text") or "")

@@ -240,12 +240,14 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
     found_terms = list(terms or [])
     sig = ctx.sig
 
-    def sizes(Xs: list[np.ndarray], effect: str, timing: bool) -> np.ndarray:
+    def sizes(Xs: list[np.ndarray], effect: str, timing: bool,
+              fits: list[Term | None] | None = None) -> np.ndarray:
         # (a minor correction of the same kind, kept in the fit, is part of the effect)
         rest = [t for t in found_terms if t.cand is None or t.effect != effect]
         floor = max(min_effect * noise_rms, 0.0 if timing else min_force)
         out = revealed_sizes(scorer, rest, Xs, alpha=alpha, min_gain=min_gain,
-                             min_rms=floor)
+                             min_rms=floor, fits=fits,
+                             noise=(noise_rms ** 2, lambda x: R.noise_floor(x, sig)["rms"]))
         # a lag under a fifth of the sample interval is a detail of the sampling
         dt = sig.info.get("dt_logged", sig.dt)  # the record's own sample interval
         return np.maximum(out, 0.2 * dt) if timing else out
@@ -262,7 +264,9 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
 
 
 def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
-                   alpha: float, min_gain: float, min_rms: float = 0.0) -> np.ndarray:
+                   alpha: float, min_gain: float, min_rms: float = 0.0,
+                   fits: list[Term | None] | None = None,
+                   noise: tuple[float, Any] | None = None) -> np.ndarray:
     """The smallest size ``b`` at which an effect ``b*X`` in this record would pass the
     search's acceptance test (:func:`~lugre.diagnosis.scoring.accept` on the held-out
     blocks, the ``terms`` already found in both fits), for either sign, and whose force
@@ -276,6 +280,19 @@ def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
     quadratic in what is added (read from three residuals), and those of the fit with it
     do not change (its free coefficient takes it up): every size is judged exactly, from
     three fits without the column and one with it.
+
+    ``fits`` (per column, or None): the columns the search itself fits for that effect,
+    when they are more than the one column (a friction change along the stroke is read
+    with a hat function at every knot, each free within its prior): the fit with the
+    effect is then that term's, read at the same three residuals, so that the size given
+    pays for the freedom the search takes.
+
+    ``noise``: the noise floor's variance [N^2] and the function that reads a floor
+    [N] from a residual (:func:`lugre.diagnosis.residual.noise_floor`); with it, the
+    variance unit at each size grows by the floor the effect's column alone shows
+    there, scaled by the size (a broadband effect raises the floor the search reads; a
+    first-order account: the floor is a low quantile, not a sum, so this overstates the
+    rise for effects whose band content is uneven, a cogging's).
     """
     from .scoring import _ONE_BLOCK, accept_many
 
@@ -313,23 +330,32 @@ def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
                     np.broadcast_to(ptol[:d], (m, 3, d)), np.broadcast_to(cen[:d], (m, 3, d)))
     drr = 2 * bs[:, :, None] * xr[:, None] + bs[:, :, None] ** 2 * xx[:, None]  # (m, 3, K)
     sse3 = f["sse_b"] + drr
-    score3 = f["score"] + drr.sum(-1) / scorer.s2
     grid = 2.0 ** (np.arange(-24, 49) / 8.0)  # b0/8 to 64*b0, 9 % apart
     G = grid.size
     # all columns and sizes at once: (m, 2G) sizes, either sign, in units of b0
     qs = _quadratic(np.moveaxis(sse3, 1, 0), b0[:, None])  # each (m, K)
     qp = _quadratic(np.moveaxis(f["prior"], 1, 0), b0)  # each (m,)
-    qc = _quadratic(np.moveaxis(score3, 1, 0), b0)
     held = new["b"][:, -1] / new["sc"][:, -1]  # what the residual holds along each x
     c = b0[:, None] * np.concatenate([grid, -grid])[None, :]
     add = c - held[:, None]  # what is added to the residual for a whole size c
     sse = (qs[0][:, None] + qs[1][:, None] * add[..., None]
            + qs[2][:, None] * add[..., None] ** 2)  # (m, 2G, K)
     prior = qp[0][:, None] + qp[1][:, None] * add + qp[2][:, None] * add ** 2
-    gains = ((sse - new["sse_b"][:, None]) / scorer.s2
-             + ((prior - new["prior"][:, None]) / K)[..., None])
-    gain = qc[0][:, None] + qc[1][:, None] * add + qc[2][:, None] * add ** 2 \
-        - new["score"][:, None]
+    n_sse = np.broadcast_to(new["sse_b"][:, None], sse.shape).copy()
+    n_prior = np.broadcast_to(new["prior"][:, None], prior.shape).copy()
+    for j, ft in enumerate(fits or []):
+        if ft is not None and good[j]:
+            n_sse[j], n_prior[j] = _fitted_along(scorer, terms, ft, xs[j], float(b0[j]),
+                                                 add[j])
+    unit = np.full(prior.shape, scorer.s2)
+    if noise is not None:
+        # an effect that is broadband in the record (a short pitch crossed at speed)
+        # raises the noise floor the search reads with it, and so its own unit
+        v0, floor_of = noise
+        vx = np.array([floor_of(x) ** 2 for x in xs])
+        unit = unit * (1.0 + c ** 2 * vx[:, None] / max(v0, 1e-300))
+    gains = (sse - n_sse) / unit[..., None] + ((prior - n_prior) / K)[..., None]
+    gain = (sse - n_sse).sum(-1) / unit + (prior - n_prior)
     acc = accept_many(gains.reshape(m * 2 * G, K), gain.reshape(-1), alpha=alpha,
                       min_gain=min_gain).reshape(m, 2 * G)
     ok = acc[:, :G] & acc[:, G:]  # for either sign
@@ -355,6 +381,26 @@ def revealed_sizes(scorer: Scorer, terms: list[Term], Xs: list[np.ndarray], *,
         rms = float(np.sqrt(np.mean(xm * xm))) if xm.size else 0.0
         out[j] = max(size, min_rms / rms) if rms > 0 else np.inf
     return out
+
+
+def _fitted_along(scorer: Scorer, terms: list[Term], ft: Term, x: np.ndarray, b0: float,
+                  add: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Held-out block errors ``(len(add), K)`` and prior costs of the fit with
+    the term ``ft`` when ``add`` times ``x`` is added to the residual: read from the fits
+    at ``-b0``, 0 and ``b0`` (a fit is linear in its residual, so these are quadratic)."""
+    G, h, ptol, cen = scorer._assemble(terms + [ft, Term(cand=None, h=None, X=x[:, None])])
+    d = G.shape[-1] - 1
+    gx, xx, xr = G[:, :d, d], G[:, d, d], h[:, d]
+    bs = np.array([-b0, 0.0, b0])
+    f = scorer._fit(np.broadcast_to(G[:, :d, :d], (3,) + G[:, :d, :d].shape),
+                    h[None, :, :d] + bs[:, None, None] * gx[None],
+                    np.broadcast_to(ptol[:d], (3, d)), np.broadcast_to(cen[:d], (3, d)))
+    drr = 2 * bs[:, None] * xr[None] + bs[:, None] ** 2 * xx[None]  # (3, K)
+    qs = _quadratic(f["sse_b"] + drr, b0)
+    qp = _quadratic(f["prior"], b0)
+    a = np.asarray(add)
+    sse = qs[0][None] + qs[1][None] * a[:, None] + qs[2][None] * a[:, None] ** 2
+    return sse, qp[0] + qp[1] * a + qp[2] * a ** 2
 
 
 def _quadratic(v: np.ndarray, h: Any) -> tuple[Any, Any, Any]:

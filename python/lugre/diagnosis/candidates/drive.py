@@ -15,7 +15,7 @@ from .. import residual as R
 from ..residual import Signals, position_sums
 from .base import Candidate, Context, by, by_current
 from .linear import mass_both_ways
-from .position import Cogging
+from .position import Cogging, periodic_sizes
 from .probe import amps, hide, share, two_ways, under
 from .secant import _Secant
 
@@ -84,7 +84,7 @@ class ForceRipple(Candidate):
         sig = ctx.sig
         span = max(ctx.xrange[1] - ctx.xrange[0], 1e-9)
         ks = np.geomspace(1.5 / span, max(Cogging.kmax(ctx), 2.0 / span), 6)
-        amps_ = sizes([sig.filt(sig.fm * np.sin(2 * np.pi * k * sig.x)) for k in ks])
+        amps_ = periodic_sizes(sizes, [self.columns(1.0 / k, ctx) for k in ks])
         seen = np.isfinite(amps_)
         b = share(float(np.max(amps_[seen]))) if seen.any() else math.inf
         return hide(self.effect, b, "-", f"a {U.force_words()} ripple "

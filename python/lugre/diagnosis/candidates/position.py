@@ -10,7 +10,7 @@ import numpy as np
 from ... import units as U
 from ...vocabulary import COGGING, GRAVITY, OFFSET, POSITION_FRICTION
 from ..residual import position_sums
-from .base import Candidate, Context, by
+from .base import Candidate, Context, Term, by
 from .probe import FixedInPosition, hide, share, under
 
 __all__ = ["Cogging", "Gravity", "PositionFriction"]
@@ -52,6 +52,15 @@ class Gravity(FixedInPosition, Candidate):
         b = float(np.max(sizes([ctx.sig.filt(np.sin(x - xm)), ctx.sig.filt(np.cos(x - xm))])))
         return hide(self.effect, b, "N", f"a gravity torque {under(b, '{:.2g} N m')}",
                     experiment="slow moves over a large part of a turn in both directions")
+
+
+def periodic_sizes(sizes: Any, cols: list[np.ndarray]) -> np.ndarray:
+    """Per pitch, the smallest amplitude the search would name at any phase: the
+    larger of the sine's and the cosine's, each judged with both columns free, as the
+    search fits them (``cols``: the sine and cosine columns of each pitch)."""
+    fits = [Term(cand=None, h=None, X=X) for X in cols]
+    both = sizes([X[:, j] for X in cols for j in (0, 1)], fits=[f for f in fits for _ in (0, 1)])
+    return np.max(np.asarray(both, float).reshape(len(cols), 2), axis=1)
 
 
 class Cogging(FixedInPosition, Candidate):
@@ -140,7 +149,7 @@ class Cogging(FixedInPosition, Candidate):
         span = ctx.xrange[1] - ctx.xrange[0]
         kmax = self.kmax(ctx)
         ks = np.geomspace(1.5 / max(span, 1e-9), max(kmax, 2.0 / max(span, 1e-9)), 8)
-        amps = sizes([sig.filt(np.sin(2 * np.pi * k * sig.x)) for k in ks])
+        amps = periodic_sizes(sizes, [self.columns(1.0 / k, ctx) for k in ks])
         seen = np.isfinite(amps)
         b = float(np.max(amps[seen])) if seen.any() else float("inf")
         blind = ""
@@ -200,10 +209,14 @@ class PositionFriction(Candidate):
         return {"position": [float(lo), float(hi)], "time": None, "velocity": None}
 
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
-        sig = ctx.sig
+        # a change over a tenth of the stroke each side of the mean position, as the
+        # search reads it: with every knot's hat free within its prior
+        hats = self.columns(None, ctx)
+        kn = self.knots(ctx)
         span = ctx.xrange[1] - ctx.xrange[0]
-        b = share(float(sizes([sig.filt(ctx.fcs * (np.abs(sig.x - np.mean(sig.x))
-                                                   < 0.1 * span))])[0]))
+        bump = hats @ (np.abs(kn - np.mean(ctx.sig.x)) < 0.1 * span).astype(float)
+        ft = Term(cand=None, h=None, X=hats, prior=self.prior_tol(None, ctx))
+        b = share(float(sizes([bump], fits=[ft])[0]))
         return hide(self.effect, b, "-", f"a friction change {under(100 * b, '{:.2g} %')} "
                     "over a tenth of the stroke")
 

@@ -114,12 +114,40 @@ class StribeckShape(_Secant):
             return hide(self.effect, float("inf"), "-", "the shape of the Stribeck curve (the "
                         "model has no static level above the Coulomb level, fs = fc)",
                         experiment=exp)
-        b = float(sizes([self.columns(1.0, ctx)[:, 0]])[0])  # exponent 2 -> 1
-        if not np.isfinite(b) or b > 5:
+        lo, hi = self._hidden_exponents(ctx, sizes)
+        if lo is None and hi is None:
             return hide(self.effect, float("inf"), "-", "the shape of the Stribeck curve",
                         experiment=exp)
-        return hide(self.effect, b, "-", f"a Stribeck exponent within {b:.2g} of 2",
+        b = max(2.0 - (lo if lo is not None else self.BELOW[-1]),
+                (hi if hi is not None else self.ABOVE[-1]) - 2.0)
+        if lo is not None and hi is not None:
+            what = f"a Stribeck exponent between {lo:.3g} and {hi:.3g} (2 in the model)"
+        elif lo is not None:
+            what = (f"a Stribeck exponent over {lo:.3g} (2 in the model; tried up to "
+                    f"{self.ABOVE[-1]:.3g})")
+        else:
+            what = (f"a Stribeck exponent under {hi:.3g} (2 in the model; tried down to "
+                    f"{self.BELOW[-1]:.3g})")
+        return hide(self.effect, b, "-", what, rng=[lo, hi],
                     experiment=exp if slow < 0.05 else "")
+
+    #: Exponents tried each side of the model's 2 for the limit.
+    BELOW = (1.85, 1.7, 1.55, 1.4, 1.25, 1.1, 0.95, 0.8, 0.65, 0.5)
+    ABOVE = (2.2, 2.45, 2.75, 3.1, 3.5, 4.0, 4.7, 5.5, 6.5, 8.0)
+
+    def _hidden_exponents(self, ctx: Context, sizes: Any
+                          ) -> tuple[float | None, float | None]:
+        """The exponents each side of 2 from which the search would name the shape,
+        each judged by the exact change of the residual that it makes (the shape is far
+        from linear in the exponent: 2 -> 3 changes the curve less than 2 -> 1)."""
+        pts = list(self.BELOW) + list(self.ABOVE)
+        cols = self.columns_many(pts, ctx) or [self.columns(h, ctx) for h in pts]
+        sz = np.asarray(sizes([X[:, 0] for X in cols]), float)  # 1: the whole change
+        seen = np.isfinite(sz) & (sz <= 1.0)
+        nb = len(self.BELOW)
+        lo = next((h for h, ok in zip(self.BELOW, seen[:nb]) if ok), None)
+        hi = next((h for h, ok in zip(self.ABOVE, seen[nb:]) if ok), None)
+        return lo, hi
 
     figure = by("v", "velocity [m/s]")
 
