@@ -74,3 +74,27 @@ def test_a_current_lag_the_fit_took_into_sigma1_is_named():
     assert [f.effect for f in dg.findings] in (["delay"], ["current_lag"]), dg.summary()
     assert dg.fit["holdout_after"]["rms_force"] < 0.85 * dg.fit["holdout_before"]["rms_force"]
     assert any("refitted beside the lag" in n for n in dg.notes), dg.notes
+
+
+def test_a_model_diagnosed_on_its_own_record_says_what_the_fit_took_in():
+    """A payload on the record ``lugre fit`` used is inside the fitted mass: the
+    diagnosis of that same record says so, and gives no finite limit for a payload or
+    a constant force; another record of the axis is not told so."""
+    rec, hold, believed, _ = case([{"effect": "mass", "delta": 2.0}], seed=7, axis_seed=301,
+                                  duration=6.0)
+    fitted, _fit = fit_model(rec, force_constant=believed.force_constant)
+    fitted = fitted.replace(controller=believed.controller)
+    own = fitted.to_dict()["identification"]["record"]
+    assert own["samples"] == len(rec) and own == rec.fingerprint()
+
+    def limits(dg):
+        return {c["effect"]: c for c in dg.could_not_reveal}
+
+    same = diagnose(rec, fitted)
+    assert any("fitted on this very record" in n for n in same.notes)
+    assert limits(same)["mass"]["smallest"] is None
+    assert "fitted on this very record" in limits(same)["mass"]["text"]
+    other = diagnose(hold, fitted)
+    assert not any("fitted on this very record" in n for n in other.notes)
+    assert all("fitted on this very record" not in c["text"]
+               for c in other.could_not_reveal)

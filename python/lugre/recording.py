@@ -174,6 +174,22 @@ class Recording:
     def __len__(self) -> int:
         return int(self.t.size)
 
+    def fingerprint(self) -> dict[str, Any]:
+        """What identifies this record's samples: their count, first time and duration
+        [s], and a digest of the time, position and current (or force) values, so that
+        a model fitted on it can tell the record again (read from the same file, the
+        values are the same to the bit)."""
+        import hashlib
+
+        h = hashlib.sha256()
+        for name in ("t", "x", "i", "F"):
+            a = getattr(self, name)
+            if a is not None:
+                h.update(name.encode())
+                h.update(np.ascontiguousarray(a, dtype="<f8").tobytes())
+        return {"samples": len(self), "start_s": float(self.t[0]),
+                "duration_s": float(self.t[-1] - self.t[0]), "digest": h.hexdigest()[:20]}
+
     @property
     def dt(self) -> float:
         """Median sample interval [s] (``nan`` for a single sample)."""

@@ -111,7 +111,8 @@ def _identified(rec: Any, model: Model, fit: Any, cutoff_hz: float | None,
     noise floor, every parameter with its interval): the file says that ``lugre fit``
     made it, so that ``diagnose`` takes its base as an estimate from the record."""
     nrmse = evaluate(rec, model, cutoff_hz=cutoff_hz, backend=backend)["nrmse_force"]
-    return model.replace(identification=identification(fit, model, nrmse))
+    ident = identification(fit, model, nrmse)
+    return model.replace(identification={**ident, "record": as_recording(rec).fingerprint()})
 
 
 def _gravity_set_aside(res: Any) -> Any:

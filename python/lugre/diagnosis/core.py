@@ -32,6 +32,7 @@ from .options import (
 from .prepare import Prepared, prepare
 from .question import Questioned, contradicted_beside, question, without
 from .rebase import far_base
+from .samerecord import fitted_on_this_record, say_fitted_here
 from .report import Diagnosis
 from .search import release_columns
 from .select import select
@@ -147,6 +148,9 @@ def diagnose(
             "levels" + (" and mass were" if "mass" in fitted else " were") + " re-estimated "
             "as freely as in identification, so that an effect the fit took into them can "
             "be named.")
+    if fitted_on_this_record(model.to_dict().get("identification") or {}, rec):
+        with U.axis(model.kind):
+            dg = say_fitted_here(dg, "mass" in fitted)
     if model.is_passive and not dg.augmented.is_passive:
         warnings.warn(
             "the augmented model's sigma1 exceeds the passivity bound 4*sigma2*fc/(fs - fc) "
