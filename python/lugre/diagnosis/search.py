@@ -13,6 +13,15 @@ import numpy as np
 from .. import units as U
 from ..exceptions import DataError, LugreError, ParameterError
 from .candidates import Candidate, Context, Term
+from .colcache import (
+    contribution_rms,
+    contribution_rows,
+    make_term,
+    prefetch,
+    reads_rows,
+    release_columns,
+    whole,
+)
 from .scoring import (
     _ONE_BLOCK,
     Evaluation,
@@ -20,73 +29,9 @@ from .scoring import (
     _one_block,
     accept,
     compare,
-    rows_of,
 )
 
 __all__ = ["forward_select", "make_term", "prefetch", "release_columns"]
-
-
-def make_term(c: Candidate, h: Any, ctx: Context, *, rows: bool = False) -> Term:
-    """Build a :class:`Term` with its columns and prior.
-
-    The columns depend on the candidate, its parameter and the context's base model only,
-    so they are kept on the context: the forward selection profiles the same grids at
-    every step. With ``rows``, the term holds only the rows the scorers read
-    (``ctx.extra["rows_step"]``): what a profile over a grid needs, at a fraction of the
-    memory; such a term is for scoring only.
-    """
-    step = int(ctx.extra.get("rows_step", 1))
-    cache = ctx.extra.setdefault(("cache", id(ctx.model)), {})
-    key = _column_key(c, h, step if rows else 1)
-    X = cache.get(key)
-    if X is None:
-        X = c.columns(h, ctx)
-        if rows:
-            X = rows_of(X, step)
-        cache[key] = X
-    return Term(cand=c, h=h, X=X, prior=c.prior_tol(h, ctx), center=c.prior_center(h, ctx))
-
-
-def release_columns(ctx: Context) -> None:
-    """Drop the columns :func:`make_term` and :func:`prefetch` keep on ``ctx``.
-
-    The search profiles the same grids at every step and in its later runs (a refusal,
-    a look-alike), so the columns stay while it lasts; after it nothing reads them (the
-    joint refit builds its own), and on a million-sample record they are 650 MB
-    (every grid point's columns at the rows the scorers read, every other candidate's
-    whole). The terms chosen keep their own columns."""
-    for key in [k for k in ctx.extra if isinstance(k, tuple) and k[:1] == ("cache",)]:
-        del ctx.extra[key]
-
-
-def _column_key(c: Candidate, h: Any, step: int = 1) -> tuple[Any, ...]:
-    return ("columns", c.effect, h if isinstance(h, (tuple, str)) or h is None else float(h),
-            step)
-
-
-#: Most column bytes built in one parallel batch.
-_BATCH_BYTES = 64 * 2**20
-
-
-def prefetch(c: Candidate, hs: Any, ctx: Context) -> None:
-    """Build the missing columns of grid points ``hs`` in parallel batches, when the
-    candidate can (``columns_many``), into the cache :func:`make_term` reads (the rows
-    the scorers read only)."""
-    many = getattr(c, "columns_many", None)
-    if many is None:
-        return
-    step = int(ctx.extra.get("rows_step", 1))
-    cache = ctx.extra.setdefault(("cache", id(ctx.model)), {})
-    todo = [h if isinstance(h, tuple) else float(h) for h in hs]
-    todo = [h for h in todo if _column_key(c, h, step) not in cache]
-    per = max(1, _BATCH_BYTES // (8 * max(len(ctx.sig), 1)))
-    for i in range(0, len(todo), per):
-        chunk = todo[i:i + per]
-        cols = many(chunk, ctx)
-        if cols is None:
-            return
-        for h, X in zip(chunk, cols):
-            cache[_column_key(c, h, step)] = rows_of(X, step)
 
 
 def _profile(scorer: Scorer, kept: list[Term], c: Candidate, grid: np.ndarray, ctx: Context
@@ -100,7 +45,7 @@ def _profile(scorer: Scorer, kept: list[Term], c: Candidate, grid: np.ndarray, c
     q = scorer.J.shape[1]
     start = q + sum(t.X.shape[1] for t in kept)
 
-    on_rows = int(ctx.extra.get("rows_step", 1)) == scorer.step > 1
+    on_rows = reads_rows(scorer, ctx)
 
     def run(hs: Any) -> list[tuple[Any, float, np.ndarray]]:
         prefetch(c, hs, ctx)
@@ -126,7 +71,7 @@ def _profile(scorer: Scorer, kept: list[Term], c: Candidate, grid: np.ndarray, c
         rows.sort(key=lambda r: r[0])
     best = min(rows, key=lambda r: r[1])
     # the chosen point with all its samples (the grid was scored on the rows read)
-    term = make_term(c, best[0], ctx)
+    term = make_term(c, best[0], ctx, summed=on_rows)
     ev = scorer.evaluate(kept + [term])
     term.profile = {"h": np.array([r[0] for r in rows]) if numeric else None,
                     "h_obj": [r[0] for r in rows],
@@ -244,15 +189,14 @@ def _try_columns(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidat
         h = c.choose(cur.resid, ctx)
         if h is None and c.chooses:
             return None  # no parameter the record resolves (a cogging pitch)
-        term = make_term(c, h, ctx)
+        term = make_term(c, h, ctx, summed=reads_rows(scorer, ctx))
         ev = scorer.evaluate(kept + [term])
     trial = kept + [term]
     evid = compare(cur, ev, scorer.s2)
     ok, why = accept(evid, alpha=rules.alpha, min_gain=rules.min_gain)
     start = scorer.J.shape[1] + sum(t.X.shape[1] for t in trial[:-1])
     beta = ev.beta[start:start + term.X.shape[1]]
-    # rms, not std: a constant force is a contribution too
-    contrib = float(np.sqrt(np.mean(np.einsum("ij,j->i", term.X, beta)[scorer.mask] ** 2)))
+    contrib = contribution_rms(term, beta, scorer.mask, ctx)
     bad = _unphysical(c, h, beta, ctx)
     if bad is not None:  # e.g. a negative drag: the column fits, the physics not
         ok, why = False, f"not physical: {bad}"
@@ -260,7 +204,7 @@ def _try_columns(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidat
         ok, why = False, (f"lag of {beta[0] * 1e3:.3g} ms is below a fifth of the "
                           "sample interval: a timing detail of the sampled record")
     if ok:
-        ok, why = _spread(scorer, term.X @ beta, ctx, ok, why)
+        ok, why = _spread(scorer, contribution_rows(term, beta, ctx), ctx, ok, why)
     if ok and contrib < rules.min_effect * rules.noise_rms:
         ok, why = False, "contribution small against the noise floor"
     minor = False
@@ -384,6 +328,7 @@ def forward_select(
         if step_out is None:
             break
         terms, cur, drop = step_out
+        terms, cur = whole(terms, cur, ctx)  # (the residual it leaves is read whole)
         if drop is not None:
             cands = [c for c in cands if c.effect != drop]
     return terms, cur, log
@@ -422,7 +367,7 @@ def _take(scorer: Scorer, terms: list[Term], cur: Evaluation, best: Any,
     # (and when it would replace the simpler one already found, add a force of
     # practical size beyond it, or the search goes on without it)
     held = [s_ for s_ in (bc[4].supersedes if bc else ()) if s_ in chosen]
-    if held and _rms_between((None, terms, cur), best, q, m, held[0]) < practical:
+    if held and _rms_between((None, terms, cur), best, q, m, ctx, held[0]) < practical:
         log[best[3]]["ok"] = False
         log[best[3]]["why"] += (f"; not taken: beyond the {held[0]} found it adds a "
                                 f"{U.force_words()} under the practical size (parsimony)")
@@ -434,7 +379,7 @@ def _take(scorer: Scorer, terms: list[Term], cur: Evaluation, best: Any,
             # practical size (an offset read as a spring of -0.0175 N/m with x0 at
             # 171 m on a 0.15 m stroke: 0.003 N of slope, bought by a small mass
             # error the sines' positions follow)
-            extra = _rms_between(okays[simple], best, q, m)
+            extra = _rms_between(okays[simple], best, q, m, ctx)
             if not accept(nested, alpha=rules.alpha, min_gain=rules.min_gain)[0]:
                 why = "does not pass the test against it"
             elif extra < practical:
@@ -474,24 +419,25 @@ def _only_beside_minor(scorer: Scorer, terms: list[Term], best: Any, rules: _Rul
     return ", ".join(t.effect for t in minors)
 
 
-def _contribution(trial: list[Term], ev: Evaluation, j: int, q: int) -> np.ndarray:
+def _contribution(trial: list[Term], ev: Evaluation, j: int, q: int, ctx: Context
+                  ) -> np.ndarray:
     """The force [N] term ``j`` of a fitted trial stands for (the base's ``q``
-    coefficients first)."""
+    coefficients first), at every sample."""
     start = q + sum(t.X.shape[1] for t in trial[:j])
-    x = trial[j].X
+    x = whole([trial[j]], ev, ctx)[0][0].X
     return np.einsum("ij,j->i", x, ev.beta[start:start + x.shape[1]])
 
 
 def _rms_between(simple: tuple[Any, ...], big: tuple[Any, ...], q: int,
-                 m: np.ndarray, effect: str | None = None) -> float:
+                 m: np.ndarray, ctx: Context, effect: str | None = None) -> float:
     """Rms [N] over the samples ``m`` of what the last term of the trial ``big`` adds
     beyond the term of ``simple`` (each ``(gain, trial, evaluation, ...)``): its last
     term, or the one of ``effect``."""
     ts = simple[1]
     j = len(ts) - 1 if effect is None else next(
         i for i, t in enumerate(ts) if t.effect == effect)
-    d = (_contribution(big[1], big[2], len(big[1]) - 1, q)
-         - _contribution(ts, simple[2], j, q))[m]
+    d = (_contribution(big[1], big[2], len(big[1]) - 1, q, ctx)
+         - _contribution(ts, simple[2], j, q, ctx))[m]
     return float(np.sqrt(np.mean(d * d))) if d.size else 0.0
 
 

@@ -1,13 +1,13 @@
 """``lugre fleet run``: every recording not yet in the history diagnosed on a Dask cluster,
 each result stored as it arrives.
 
-The cluster is a local one of ``workers`` processes (one thread each: the diagnosis is
-single-threaded NumPy and Rust work) unless ``scheduler`` gives the address of a running
-one, whose workers must import lugre and read the fleet's folder at the same path. A
-worker that dies has its tasks moved to another by the scheduler (up to its
-``distributed.scheduler.allowed-failures``, 3 by default); a task that fails with an
-exception is retried ``RETRIES`` times; a recording whose tasks keep failing is stored
-as an error and the run goes on.
+The cluster (:mod:`lugre.fleet.cluster`) is a local one of ``workers`` processes (one
+thread each: the diagnosis is single-threaded NumPy and Rust work) unless ``scheduler``
+gives the address of a running one, whose workers must import lugre and read the
+fleet's folder at the same path. A worker that dies has its tasks moved to another by
+the scheduler (up to its ``distributed.scheduler.allowed-failures``, 3 by default); a
+task that fails with an exception is retried ``RETRIES`` times; a recording whose tasks
+keep failing is stored as an error and the run goes on.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .cluster import client as _client
 from .discover import Axis, discover, file_stamp
 from .store import open_store
 from .task import diagnose_file, failed
@@ -69,32 +70,6 @@ def _models(axes: list[Axis]) -> dict[str, Any]:
     from ..model import load_model
 
     return {ax.name: load_model(ax.model) for ax in axes}
-
-
-def _client(scheduler: str | None, workers: int) -> tuple[Any, Any]:
-    try:
-        from dask.distributed import Client, LocalCluster
-    except ImportError:
-        from ..exceptions import InputError
-
-        raise InputError("lugre fleet runs on Dask: pip install 'lugre[fleet]' "
-                         "(dask[distributed], duckdb)", name="--scheduler") from None
-    if scheduler:
-        try:
-            return Client(scheduler, timeout="20s"), None
-        except OSError as e:
-            from ..exceptions import InputError
-
-            raise InputError(f"cannot reach the Dask scheduler at {scheduler} ({e}): start "
-                             "one (dask scheduler) or leave --scheduler out for a local "
-                             "cluster", name="--scheduler") from None
-    import logging
-
-    # one thread per worker, the core's (rayon) pool included: N workers use N cores
-    cluster = LocalCluster(n_workers=workers, processes=True, threads_per_worker=1,
-                           dashboard_address=None, silence_logs=logging.ERROR,
-                           env={"RAYON_NUM_THREADS": "1"})
-    return Client(cluster), cluster
 
 
 def run(root: str | os.PathLike[str], db: str | os.PathLike[str], *,

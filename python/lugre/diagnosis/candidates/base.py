@@ -264,6 +264,10 @@ class Term:
     #: that it does not leak into other terms, reported as a minor correction, never
     #: as a finding
     minor: bool = False
+    #: set when ``X`` holds only the rows the scorers read (a trial of the search on a
+    #: long record): the Gram matrix of all its columns over the samples used and that
+    #: mask (:mod:`lugre.diagnosis.colcache`)
+    gram: tuple[np.ndarray, np.ndarray] | None = None
 
     @property
     def effect(self) -> str:

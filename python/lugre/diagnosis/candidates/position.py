@@ -15,6 +15,10 @@ from .probe import FixedInPosition, hide, share, under
 
 __all__ = ["Cogging", "Gravity", "PositionFriction"]
 
+#: Hat columns built and low-passed at once (every column is filtered on its own: the
+#: same numbers in any grouping).
+_AT_ONCE = 8
+
 
 class Gravity(FixedInPosition, Candidate):
     """A load's weight on a joint, ``torque*sin(x + phase)``: two columns, ``sin(x)``
@@ -183,11 +187,18 @@ class PositionFriction(Candidate):
         return np.linspace(lo, hi, n)
 
     def columns(self, h: Any, ctx: Context) -> np.ndarray:
+        """The hat of each knot times the Coulomb/static friction, low-passed; built and
+        filtered a few columns at a time into the result (on a long record the 25
+        columns are 200 MB, and the hats and their product whole would triple it)."""
         kn = self.knots(ctx)
         x = np.clip(ctx.sig.x, kn[0], kn[-1])
         eye = np.eye(kn.size)
-        hats = np.column_stack([np.interp(x, kn, eye[j]) for j in range(kn.size)])
-        return ctx.sig.filt(hats * ctx.fcs[:, None])
+        out = np.empty((x.size, kn.size))
+        for j0 in range(0, kn.size, _AT_ONCE):
+            js = range(j0, min(j0 + _AT_ONCE, kn.size))
+            hats = np.column_stack([np.interp(x, kn, eye[j]) for j in js])
+            out[:, js.start:js.stop] = ctx.sig.filt(hats * ctx.fcs[:, None])
+        return out
 
     def prior_tol(self, h: Any, ctx: Context) -> np.ndarray | None:
         return np.full(self.knots(ctx).size, 0.3)
