@@ -6,7 +6,6 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-
 from lugre.diagnosis.candidates import Term
 from lugre.diagnosis.partial import PARTIAL_SHARE, explained_share, partial_refusal
 from lugre.diagnosis.scoring import Scorer, compare

@@ -32,8 +32,8 @@ from .options import (
 from .prepare import Prepared, prepare
 from .question import Questioned, contradicted_beside, question, without
 from .rebase import far_base
-from .samerecord import fitted_on_this_record, say_fitted_here
 from .report import Diagnosis
+from .samerecord import fitted_on_this_record, say_fitted_here
 from .search import release_columns
 from .select import select
 from .weigh import weigh

@@ -24,7 +24,7 @@ import numpy as np
 
 from .scoring import Evaluation, Scorer
 
-__all__ = ["PARTIAL_SHARE", "CONFINED", "explained_share", "partial_refusal"]
+__all__ = ["CONFINED", "PARTIAL_SHARE", "explained_share", "partial_refusal"]
 
 #: Least share of the mismatch beyond the noise, in the blocks where a term taken on the
 #: confined route gained, that the findings together must remove.

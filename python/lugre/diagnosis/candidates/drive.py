@@ -81,7 +81,6 @@ class ForceRipple(Candidate):
         return {"position": list(ctx.xrange), "time": None, "velocity": None}
 
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
-        sig = ctx.sig
         span = max(ctx.xrange[1] - ctx.xrange[0], 1e-9)
         ks = np.geomspace(1.5 / span, max(Cogging.kmax(ctx), 2.0 / span), 6)
         amps_ = periodic_sizes(sizes, [self.columns(1.0 / k, ctx) for k in ks])

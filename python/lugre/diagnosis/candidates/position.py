@@ -149,7 +149,6 @@ class Cogging(FixedInPosition, Candidate):
         return [{"effect": COGGING, "amplitude": amp, "pitch": float(h), "phase": phase}]
 
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
-        sig = ctx.sig
         span = ctx.xrange[1] - ctx.xrange[0]
         kmax = self.kmax(ctx)
         ks = np.geomspace(1.5 / max(span, 1e-9), max(kmax, 2.0 / max(span, 1e-9)), 8)
