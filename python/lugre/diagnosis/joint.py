@@ -17,6 +17,7 @@ from . import base as B
 from . import candidates as E
 from . import residual as R
 from .candidates import Term
+from .candidates.secant import _Secant
 from .options import Options
 from .prepare import Prepared
 from .refit import refine, split
@@ -100,6 +101,18 @@ def _dropped(log: list[dict[str, Any]], effect: str, reason: str) -> None:
     if lg is not None:
         lg["accepted"] = False
         lg["why"] += "; dropped: " + reason
+
+
+def _contribution(t: Term, beta: np.ndarray, ctx: E.Context, mask: np.ndarray) -> float:
+    """A term's rms contribution [N] in its exact form: an effect read along a secant
+    (a dead-band, a current limit, a Stribeck exponent) is the change its parameter,
+    as the coefficient maps it, makes to the residual; the coefficient times the secant
+    is not (a negative dead-band coefficient maps to no band at all, however large the
+    secant's share: a clean record was named "a dead-band of 0 mA")."""
+    c = t.cand
+    if isinstance(c, _Secant) and np.size(beta) == 1:
+        return rms(c.columns(c.from_secant(t.h, float(beta[0])), ctx)[:, 0], mask)
+    return rms(c.columns(t.h, ctx) @ beta, mask)
 
 
 def _first_fit(rf: _Refitter, sel: Selection, w: Weighing) -> tuple[Joint, dict[str, float]]:
@@ -267,4 +280,16 @@ def refit(prep: Prepared, w: Weighing, sel: Selection, opts: Options) -> Joint:
     if weak:
         j = rf.drop(weak, j)
     j = _noise_made(rf, prep, sel, j)
+    collapsed = _collapsed(rf, j)
+    if collapsed:  # (a refit after a drop took it to nothing)
+        j = rf.drop(collapsed, j)
     return replace(j, mass_ways=_mass_still(rf, j, sel.own_check(E.Mass.effect)))
+
+
+def _collapsed(rf: _Refitter, j: Joint) -> dict[int, str]:
+    """Named terms that, in their exact form as the last refit left them, change the
+    force by nothing (a dead-band refitted to 0 mA once a resonance beside it went)."""
+    scale = rms(rf.sig.fm_f, rf.sig.mask)
+    return {k: "refitted with the rest, in its exact form it no longer changes the force"
+            for k, t in enumerate(j.terms) if not t.minor and not t.cand.timing
+            and _contribution(t, j.betas[k], j.ctx, rf.sig.mask) <= 1e-9 * scale}
