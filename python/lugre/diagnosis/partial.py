@@ -39,7 +39,7 @@ def explained_share(scorer: Scorer, ev: Evaluation, gains: np.ndarray,
     ``gains`` (per-block score gains) are positive, that ``ev`` removes."""
     pos = np.asarray(gains) > 0
     base = scorer.evaluate([])
-    floor = noise_rms ** 2 * scorer._nb * scorer.step  # noise alone, in one block [N^2]
+    floor = noise_rms ** 2 * scorer.block_samples  # noise alone, in one block [N^2]
     before = float(np.maximum(base.sse_b[pos] - floor, 0.0).sum())
     after = float(np.maximum(ev.sse_b[pos] - floor, 0.0).sum())
     return 1.0 - after / before if before > 0 else 1.0

@@ -31,15 +31,14 @@ def fitted_on_this_record(identification: dict[str, Any], rec: Recording) -> boo
 
 def _hidden(entry: dict[str, Any], mass_fitted: bool) -> dict[str, Any]:
     if entry.get("effect") == MASS and mass_fitted:
-        what = "a payload of any size cannot be seen in this record: the model's mass"
+        what = ("a payload of any size cannot be seen in this record: the model's mass was "
+                "fitted on this very record and holds it")
     elif entry.get("effect") == OFFSET:
         what = ("a constant force of any size cannot be seen in this record: the model's "
-                "per-direction friction levels")
+                "per-direction friction levels were fitted on this very record and hold it")
     else:
         return entry
-    return {**entry, "smallest": None, "experiment": U.words(_AGAIN),
-            "text": U.words(what + " were fitted on this very record and hold it")
-            .replace("mass were", "mass was")}
+    return {**entry, "smallest": None, "experiment": U.words(_AGAIN), "text": U.words(what)}
 
 
 def say_fitted_here(dg: Any, mass_fitted: bool) -> Any:

@@ -145,6 +145,11 @@ class Scorer:
         self._rr = self._gram(self._rm, self._rm)[:, 0, 0]
 
     @property
+    def block_samples(self) -> int:
+        """Samples of the record in one held-out block (rows read times ``step``)."""
+        return self._nb * self.step
+
+    @property
     def used_blocks(self) -> list[slice]:
         """The held-out blocks as slices of the used samples (``r[mask]``), every
         sample of each stretch, not only those read."""

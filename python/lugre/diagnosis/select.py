@@ -97,9 +97,9 @@ def _refuse(w: Weighing, bs: BaseSet, cands: list[E.Candidate], opts: Options,
     # (after a refusal the search runs again and may name a term checked before: every
     # check is read again until none refuses)
     while True:
-        out = _own_check(w, bs, checked, refused, terms, ev) or partial_refusal(
-            bs.scorer, [t for t in terms if t.effect not in refused], ev, log,
-            w.noise["rms"])
+        # (a refused effect is no longer a candidate: the terms never hold one)
+        out = (_own_check(w, bs, checked, refused, terms, ev)
+               or partial_refusal(bs.scorer, terms, ev, log, w.noise["rms"]))
         if out is None:
             return terms, ev, log, refused
         effect, chk, why = out
