@@ -14,9 +14,10 @@ from .. import units as U
 from ..exceptions import PassivityWarning
 from ..io import Recording
 from ..model import Model, _as_model
-from ..vocabulary import ONE_OF_A_KIND
+from ..vocabulary import ONE_OF_A_KIND, kind
 from . import evidence as V
 from . import residual as R
+from .absorbed import ABSORBING, absorbed_effect
 from .assemble import assemble
 from .evaluation import as_recording, evaluate, level_shift, level_shift_text
 from .findings import gather
@@ -125,20 +126,16 @@ def diagnose(
         warnings.simplefilter("ignore", PassivityWarning)
         dg = _run(rec, model, opts)
         # the base is a starting point: when the record puts it far from where it was
-        # given, the search runs again from where the record puts it
-        far = None if candidates is not None else far_base(
+        # given, the search runs again from where the record puts it (for a fitted base,
+        # also where it bent itself to mimic an effect)
+        first = dg
+        if fitted and candidates is None:
+            dg = _absorbed(rec, model, dg, opts)
+        far = None if candidates is not None or dg is not first else far_base(
             rec, model, dg.augmented, cutoff_hz=cutoff_hz, backend=backend,
             free_mass=free_mass)
         if far is not None:
-            first = dg
-            dg = _run(rec, far["model"], opts)
-            dg.model = model
-            # the model as given, on this record and the held-out one, from the first
-            # pass (the second's "before" is the refitted base's)
-            dg.rebased = {**{k: v for k, v in far.items() if k != "model"},
-                          "given": first.fit["before"],
-                          "holdout_given": first.fit["holdout_before"] or None}
-            dg.verdict = V.verdict(dg)
+            dg = _from_refitted_base(rec, model, dg, far, opts)
     if "mass" in fitted:
         with U.axis(model.kind):
             dg = name_mass_change(dg, model, rec, cutoff_hz=cutoff_hz, backend=backend)
@@ -159,6 +156,40 @@ def diagnose(
             PassivityWarning, stacklevel=2)
     dg.timing = time.perf_counter() - t_start
     return dg
+
+
+def _from_refitted_base(rec: Recording, model: Model, first: Diagnosis, far: dict[str, Any],
+                        opts: Options) -> Diagnosis:
+    """The search run again from the base refitted where the record puts it; the model
+    as given, on this record and the held-out one, from the first pass (the second's
+    "before" is the refitted base's)."""
+    dg = _run(rec, far["model"], opts)
+    dg.model = model
+    dg.rebased = {**{k: v for k, v in far.items() if k != "model"},
+                  "given": first.fit["before"],
+                  "holdout_given": first.fit["holdout_before"] or None}
+    dg.verdict = V.verdict(dg)
+    return dg
+
+
+def _absorbed(rec: Recording, model: Model, first: Diagnosis, opts: Options) -> Diagnosis:
+    """A fitted base that bent itself to mimic an effect: those the base can mimic whose
+    trials gained without being named, sized with the base fitted beside them; the
+    search run again from the base beside the best, and kept when it names the effect."""
+    named = {kind(f.effect) for f in first.findings}
+    tried = [t["effect"] for t in first.trials or []
+             if t.get("effect") in ABSORBING and t["effect"] not in named
+             and float(t.get("gain") or 0.0) > opts.min_gain]
+    if not tried:
+        return first
+    far = absorbed_effect(rec, model, first.augmented, list(dict.fromkeys(tried)),
+                          cutoff_hz=opts.cutoff_hz, backend=opts.backend,
+                          free_mass=opts.free_mass, blocks=opts.blocks, alpha=opts.alpha,
+                          min_gain=opts.min_gain)
+    if far is None:
+        return first
+    dg = _from_refitted_base(rec, model, first, far, opts)
+    return dg if far["effect"] in {kind(f.effect) for f in dg.findings} else first
 
 
 def _run(rec: Recording, model: Model, opts: Options) -> Diagnosis:

@@ -1,0 +1,186 @@
+"""An effect a fitted base took in: a base that ``lugre fit`` identified on a record
+with a dead-band, a quadratic drag or a Stribeck curve of another shape in it bends its
+own levels, Stribeck speed and presliding pair to mimic the effect. The search refits
+the base only near where it was given (a linearised step), so from such a base the
+effect's column meets a residual the base has already half explained, in a shape
+nothing linear undoes: the rest is reported unexplained.
+
+Here each effect that acts through the friction or the drive's current (the ones a
+base can mimic) is sized by the base fitted again with it held, over a grid of sizes
+and a golden-section refinement; the best is tested as any term is, block by block
+against the base fitted again without it (gain over ``min_gain`` noise units and
+consistent or confined-and-overwhelming, :func:`lugre.diagnosis.scoring.accept`),
+and must lower the residual by a fifth. When one passes, the diagnosis runs again from
+the base fitted with it (that effect left out of the model), so that the search names
+it with its own evidence and no base parameter stands in for it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from .. import units as U
+from ..model import Model
+from ..vocabulary import DEADBAND, DRAG, LOAD_FRICTION, STRIBECK_SHAPE, kind
+from . import residual as R
+from .base import BASE_PARAMS, apply_base, get_base
+from .basefit import _run, base_names
+from .rebase import REBASE_GAIN, _moves
+from .scoring import accept, block_evidence
+
+__all__ = ["ABSORBING", "absorbed_effect"]
+
+#: Effects a fitted base can mimic (through its levels, Stribeck speed, viscous slope
+#: and presliding pair), with the parameter that sizes each.
+ABSORBING: dict[str, str] = {DEADBAND: "current", DRAG: "coefficient",
+                             STRIBECK_SHAPE: "exponent", LOAD_FRICTION: "coefficient"}
+
+#: Iterations of the base's polish at each size of the grid that screens the effects,
+#: and of the refinement of the best (a quick refit from the base).
+SCREEN_ITER = 12
+POLISH_ITER = 30
+
+#: Golden-section steps that refine the best size of the grid (in log size).
+REFINE_STEPS = 7
+
+
+def _grid(effect: str, sig: R.Signals, model: Model) -> np.ndarray:
+    """Trial sizes of ``effect`` on this record: a dead-band from 0.3 % to half of the
+    mean Coulomb level (in current), a drag whose force at the largest speed is 0.3 %
+    to all of the largest motor force, exponents either side of 2, load friction of
+    0.3 % to 30 % of the transmitted force."""
+    used = sig.mask
+    f99 = float(np.quantile(np.abs(sig.fm_f[used]), 0.99)) or 1.0
+    vmax = float(np.max(np.abs(sig.v[used]))) or 1e-6
+    fr = model.friction
+    level = 0.5 * (float(fr["positive"]["fc"]) + float(fr["negative"]["fc"])) or 0.1 * f99
+    if effect == DEADBAND:
+        return np.geomspace(0.003 * level, 0.5 * level, 5) / model.force_constant
+    if effect == DRAG:
+        return np.geomspace(0.003 * f99, f99, 5) / vmax ** 2
+    if effect == STRIBECK_SHAPE:
+        return np.array([0.5, 1.0, 3.0, 6.0])
+    return np.geomspace(0.003, 0.3, 5)
+
+
+def _with(model: Model, effect: str, size: float) -> Model:
+    return model.replace(effects=list(model.effects) + [{"effect": effect,
+                                                         ABSORBING[effect]: float(size)}])
+
+
+class _Polisher:
+    """The base polished with an effect held (or none): its residual's rms [N]."""
+
+    def __init__(self, sig: R.Signals, free_mass: bool) -> None:
+        self.sig, self.names = sig, base_names(free_mass)
+
+    def __call__(self, model: Model, max_iter: int = POLISH_ITER
+                 ) -> tuple[float, Model, np.ndarray]:
+        best, _ = _run(self.sig, [model], self.names, keep=1, max_iter=max_iter)
+        r = np.asarray(self.sig.kernel.residual(best))
+        used = r[self.sig.mask]
+        rms = float(np.sqrt(np.mean(used * used)))
+        return (rms if math.isfinite(rms) else math.inf), best, r
+
+
+def _golden(f: Callable[[float], float], a: float, b: float, steps: int) -> float:
+    """The minimum of ``f`` on ``[a, b]`` by golden-section search."""
+    g = (math.sqrt(5.0) - 1.0) / 2.0
+    c, d = b - g * (b - a), a + g * (b - a)
+    fc, fd = f(c), f(d)
+    for _ in range(steps):
+        if fc < fd:
+            b, d, fd = d, c, fc
+            c = b - g * (b - a)
+            fc = f(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + g * (b - a)
+            fd = f(d)
+    return c if fc < fd else d
+
+
+class _Sizes:
+    """Trial sizes of one effect with the base polished beside each: the residual's rms
+    per size, and the grid's best refined between its neighbours."""
+
+    def __init__(self, effect: str, model: Model, polish: _Polisher) -> None:
+        self.effect, self.model, self.polish = effect, model, polish
+        self.seen: dict[float, tuple[float, Model, np.ndarray]] = {}
+        self.logs = np.log(_grid(effect, polish.sig, model))
+        self.rms = np.array([self.at(float(u), SCREEN_ITER) for u in self.logs])
+
+    def at(self, log_size: float, max_iter: int = POLISH_ITER) -> float:
+        s = float(math.exp(log_size))
+        if s not in self.seen or max_iter > SCREEN_ITER:
+            self.seen[s] = self.polish(_with(self.model, self.effect, s), max_iter)
+        return self.seen[s][0]
+
+    @property
+    def best_rms(self) -> float:
+        return float(self.rms.min())
+
+    def refined(self) -> tuple[float, float, Model, np.ndarray]:
+        """(size, rms, model, residual) of the least rms, refined by golden section."""
+        k = int(np.argmin(self.rms))
+        lo, hi = self.logs[max(k - 1, 0)], self.logs[min(k + 1, self.logs.size - 1)]
+        self.seen.clear()  # (the screen's polishes are short; the refinement's are not)
+        self.at(float(self.logs[k]))
+        if hi > lo:
+            _golden(self.at, float(lo), float(hi), REFINE_STEPS)
+        size = min(self.seen, key=lambda s: self.seen[s][0])
+        return (size, *self.seen[size])
+
+
+def _blocks(r0: np.ndarray, r1: np.ndarray, sig: R.Signals, blocks: int) -> np.ndarray:
+    """Per-block gains of ``r1`` over ``r0`` in the noise units of ``r1``'s floor."""
+    used = np.flatnonzero(sig.mask)
+    nf = R.noise_floor(r1, sig)
+    s2 = nf["rms"] ** 2 * used.size / max(nf["n_eff"], 1.0)
+    parts = np.array_split(used, blocks)
+    return np.array([(np.sum(r0[p] ** 2) - np.sum(r1[p] ** 2)) / s2 for p in parts])
+
+
+def absorbed_effect(rec: Any, given: Model, augmented: Model, effects: list[str], *,
+                    cutoff_hz: float | None,
+                    backend: Any, free_mass: bool, blocks: int, alpha: float,
+                    min_gain: float) -> dict[str, Any] | None:
+    """The effect of ``effects`` the fitted base of ``given`` took in, if one passes
+    (module doc).
+
+    Returns None, or (as :func:`lugre.diagnosis.rebase.far_base`) ``model`` (the given
+    model with the base fitted beside the effect; the effect itself left out),
+    ``moves``, ``rms_given`` and ``rms_refit`` [N], ``text``, and ``effect`` with
+    ``size`` and ``evidence`` (the block test against the base polished without it).
+    """
+    sig = R.prepare(rec, augmented, cutoff_hz=cutoff_hz, backend=backend)
+    polish = _Polisher(sig, free_mass)
+    rms0, _, r0 = polish(augmented)
+    held = {kind(e["effect"]) for e in augmented.effects}
+    tried = [_Sizes(e, augmented, polish) for e in effects if e in ABSORBING and e not in held]
+    if not tried:
+        return None
+    # the grids screen the effects; only the best is refined and tested, when its
+    # screen took half of the fifth already
+    top = min(tried, key=lambda z: z.best_rms)
+    if top.best_rms > (1.0 - 0.5 * REBASE_GAIN) * rms0:
+        return None
+    size, rms1, fitted, r1 = top.refined()
+    ev = block_evidence(_blocks(r0, r1, sig, blocks))
+    ok, _ = accept(ev, alpha=alpha, min_gain=min_gain)
+    if not (ok and rms1 < (1.0 - REBASE_GAIN) * rms0):
+        return None
+    best = {"effect": top.effect, "size": size, "rms_refit": rms1, "evidence": ev}
+    refit = apply_base(given, {n: get_base(fitted, n) for n, _ in BASE_PARAMS})
+    moves = _moves(given, refit, base_names(free_mass))
+    name = ABSORBING[best["effect"]]
+    size = U.fmt(best["size"], U.unit_of(best["effect"], name), 3)
+    text = (f"the fitted base had bent itself to mimic {best['effect']} (a {name} of "
+            f"about {size}): refitted beside it, the {U.force_words()} residual falls from "
+            f"{rms0:.3g} to {best['rms_refit']:.3g} {U.si('N')} rms. The search was run "
+            "again from that base, so that no base parameter stands in for the effect")
+    return {**best, "model": refit, "moves": moves, "rms_given": rms0, "text": text}
