@@ -95,7 +95,8 @@ def _diagnose(case: dict[str, Any], rec: dict[str, np.ndarray], hold: dict[str, 
         "trials_p_under_alpha": sum(p < ALPHA for p in ps),
         "accepted_overwhelming": sum(1 for tr in trials if tr.get("accepted")
                                      and not tr.get("p", 1.0) < ALPHA),
-        "could_not_reveal": [{k: c.get(k) for k in ("effect", "smallest", "unit", "text", "range")}
+        "could_not_reveal": [{k: c.get(k) for k in ("effect", "smallest", "unit", "text", "range",
+                                                         "by_pitch")}
                              for c in d.get("could_not_reveal") or []],
         "nrmse_before": d["fit"]["before"]["nrmse_force"],
         "nrmse_after": d["fit"]["after"]["nrmse_force"],
@@ -152,6 +153,39 @@ def _freq_range(text: str) -> tuple[float, float] | None:
     return (float(m.group(1)), float(m.group(2))) if m else None
 
 
+def _at_pitch(by_pitch: dict[str, Any], pitch: float) -> float | None:
+    """The reported limit at ``pitch``, interpolated in log pitch and log size."""
+    p, b = by_pitch.get("pitch") or [], by_pitch.get("smallest") or []
+    pts = sorted((math.log(pp), math.log(bb)) for pp, bb in zip(p, b) if bb and bb > 0)
+    if len(pts) < len(p) or len(pts) < 2:
+        return None
+    xs, ys = zip(*pts)
+    return float(math.exp(np.interp(math.log(pitch), xs, ys)))
+
+
+def _periodic(name: str, mult: float, s: float, lim: dict[str, Any],
+              limits: dict[str, dict[str, Any]], ph: float, rng: np.random.Generator
+              ) -> tuple[dict[str, Any] | None, str]:
+    """A cogging or a ripple at a pitch drawn in the middle half (in log) of the range
+    searched, sized at ``mult`` times the limit the report gives at that pitch (the
+    largest over the range on reports without limits per pitch)."""
+    bp = lim.get("by_pitch")
+    if bp and bp.get("pitch"):
+        pr: tuple[float, float] | None = (min(bp["pitch"]), max(bp["pitch"]))
+    else:
+        pr = _pitch_range(limits.get("cogging", {}).get("text") or "")
+    if pr is None:
+        return None, "no pitch range in the report"
+    u = float(rng.uniform(0.25, 0.75))
+    pitch = float(np.exp(np.log(pr[0]) + u * (np.log(pr[1]) - np.log(pr[0]))))
+    if bp:
+        at = _at_pitch(bp, pitch)
+        if at is None:
+            return None, "limit not finite at the drawn pitch"
+        s = mult * at
+    return {"effect": name, "amplitude": s, "pitch": pitch, "phase": ph}, ""
+
+
 def sized(name: str, mult: float, limits: dict[str, dict[str, Any]], case: dict[str, Any],
           x: np.ndarray, rng: np.random.Generator) -> tuple[dict[str, Any] | None, str]:
     """The effect ``name`` at ``mult`` times the record's reported limit, or None and
@@ -173,13 +207,7 @@ def sized(name: str, mult: float, limits: dict[str, dict[str, Any]], case: dict[
     if name == "mass":
         return {"effect": "mass", "delta": s}, ""
     if name in ("cogging", "force_ripple"):
-        pr = _pitch_range(limits.get("cogging", {}).get("text") or "")
-        if pr is None:
-            return None, "no pitch range in the report"
-        u = float(rng.uniform(0.25, 0.75))
-        pitch = float(np.exp(np.log(pr[0]) + u * (np.log(pr[1]) - np.log(pr[0]))))
-        key = "amplitude"
-        return {"effect": name, key: s, "pitch": pitch, "phase": ph}, ""
+        return _periodic(name, mult, s, lim, limits, ph, rng)
     if name == "position_friction":
         c = mean
         return {"effect": "position_friction",

@@ -15,7 +15,7 @@ from .. import residual as R
 from ..residual import Signals, position_sums
 from .base import Candidate, Context, by, by_current
 from .linear import mass_both_ways
-from .position import Cogging, periodic_sizes
+from .position import Cogging, by_pitch, periodic_sizes, pitch_bands
 from .probe import amps, hide, share, two_ways, under
 from .secant import _Secant
 
@@ -83,14 +83,17 @@ class ForceRipple(Candidate):
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
         span = max(ctx.xrange[1] - ctx.xrange[0], 1e-9)
         ks = np.geomspace(1.5 / span, max(Cogging.kmax(ctx), 2.0 / span), 6)
-        amps_ = periodic_sizes(sizes, [self.columns(1.0 / k, ctx) for k in ks])
+        amps_ = np.array([share(a) for a in periodic_sizes(
+            sizes, [self.columns(1.0 / k, ctx) for k in ks])])
         seen = np.isfinite(amps_)
-        b = share(float(np.max(amps_[seen]))) if seen.any() else math.inf
-        return hide(self.effect, b, "-", f"a {U.force_words()} ripple "
-                    f"{under(100 * b, '{:.2g} %')} of the motor {U.force_words()}",
-                    experiment=("slow constant-speed passes under a steady load (a "
-                                "current well away from zero) show the ripple apart from "
-                                "a cogging"))
+        b = float(np.max(amps_[seen])) if seen.any() else math.inf
+        return {**hide(self.effect, b, "-", f"a {U.force_words()} ripple " + pitch_bands(
+                           ks, 100 * amps_, "{:.2g} % of the motor " + U.force_words(),
+                           "{:.2g} %"),
+                       experiment=("slow constant-speed passes under a steady load (a "
+                                   "current well away from zero) show the ripple apart "
+                                   "from a cogging")),
+                "by_pitch": by_pitch(ks, amps_)}
 
 
 def _power(ctx: Context, x: np.ndarray, w: np.ndarray, k0: float, dk: float,

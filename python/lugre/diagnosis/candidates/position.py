@@ -67,6 +67,34 @@ def periodic_sizes(sizes: Any, cols: list[np.ndarray]) -> np.ndarray:
     return np.max(np.asarray(both, float).reshape(len(cols), 2), axis=1)
 
 
+def by_pitch(ks: np.ndarray, amps: np.ndarray, scale: float = 1.0) -> dict[str, Any]:
+    """The limit at each pitch searched, longest first (``pitch`` [m], ``smallest`` in
+    the entry's unit, None where any size is hidden): a periodic force's limit depends
+    on its pitch, and the largest over the range overstates it at most pitches."""
+    order = np.argsort(ks)
+    return {"pitch": [float(1.0 / ks[j]) for j in order],
+            "smallest": [float(scale * amps[j]) if np.isfinite(amps[j]) else None
+                         for j in order]}
+
+
+def pitch_bands(ks: np.ndarray, amps: np.ndarray, fmt: str, then: str | None = None) -> str:
+    """The limits of the longer and the shorter half of the pitches in words: "under
+    0.3 N at pitches 12 to 150 mm, under 0.9 N at 1.2 to 12 mm" (``then``: the format
+    of the second, ``fmt`` by default)."""
+    u, k = U.position_unit()
+    order = np.argsort(ks)  # (longest pitch first)
+    halves = (order[: (ks.size + 1) // 2], order[ks.size // 2:])
+    out = []
+    for j, half in enumerate(halves):
+        a = amps[half]
+        seen = a[np.isfinite(a)]
+        b = float(np.max(seen)) if seen.size == a.size else float("inf")
+        lead = "at pitches " if j == 0 else "at "
+        out.append(f"{under(b, fmt if j == 0 else then or fmt)} {lead}{k / ks[half].max():.3g} to "
+                   f"{k / ks[half].min():.3g} {u}")
+    return ", ".join(out)
+
+
 class Cogging(FixedInPosition, Candidate):
     effect = COGGING
     chooses = True
@@ -162,13 +190,13 @@ class Cogging(FixedInPosition, Candidate):
             blind = (f" (of any size at pitches near {pb.min():.3g} to {pb.max():.3g} "
                      f"{u}: what the friction levels cannot absorb lies in one "
                      "held-out stretch)")
-        txt = (f"a cogging {under(b, '{:.2g} ' + U.si('N'))} at pitches {k / ks[-1]:.3g} to "
-               f"{k / ks[0]:.3g} {u}{blind}, or any at pitches under "
-               f"{k / kmax:.3g} {u} (faster than the filter band at this record's "
-               "slowest motion),")
+        txt = (f"a cogging {pitch_bands(ks, amps, '{:.2g} ' + U.si('N'))}{blind}, or any at "
+               f"pitches under {k / kmax:.3g} {u} (faster than the filter band at this "
+               "record's slowest motion),")
         slow = "a few hundredths of a rad/s" if U.is_rotary() else "a few mm/s"
-        return hide(self.effect, b, "N", txt, experiment=(
-            f"slow constant-speed passes ({slow}) show short pitches"))
+        return {**hide(self.effect, b, "N", txt, experiment=(
+            f"slow constant-speed passes ({slow}) show short pitches")),
+            "by_pitch": by_pitch(ks, amps)}
 
     def where(self, h: Any, beta: np.ndarray, ctx: Context) -> dict[str, Any]:
         return {"position": list(ctx.xrange), "time": None, "velocity": None}
