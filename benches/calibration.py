@@ -264,14 +264,16 @@ def named(effect: str, findings: list[dict[str, Any]]) -> bool:
 
 
 def sweep_case(seed: int, base: dict[str, Any], max_duration: float,
-               min_duration: float = 3.0) -> list[dict[str, Any]]:
-    """One clean record regenerated with each effect at each multiple of its limit."""
+               min_duration: float = 3.0, effects: tuple[str, ...] = SWEPT
+               ) -> list[dict[str, Any]]:
+    """One clean record regenerated with each effect (of ``effects``) at each multiple
+    of its limit."""
     case = C.draw_case(seed, max_duration=max_duration, min_duration=min_duration)
     limits = {c["effect"]: c for c in base["could_not_reveal"]}
     x = np.array(base["x_range"])  # the clean record's positions: min, mean, max
     rotary = case["truth"]["axis"].get("kind") == "rotary"
     jobs, rows = [], []
-    for name in SWEPT:
+    for name in (n for n in SWEPT if n in effects):
         if name == "gravity" and not rotary:
             continue
         for mult in MULTIPLES:
@@ -452,7 +454,8 @@ def _clean_job(args: tuple[list[int], float, float]) -> list[dict[str, Any]]:
     return clean_batch(*args)
 
 
-def _sweep_job(args: tuple[int, dict[str, Any], float, float]) -> list[dict[str, Any]]:
+def _sweep_job(args: tuple[int, dict[str, Any], float, float, tuple[str, ...]]
+               ) -> list[dict[str, Any]]:
     try:
         return sweep_case(*args)
     except Exception as e:  # noqa: BLE001
@@ -472,10 +475,17 @@ def main() -> None:
     ap.add_argument("--min-duration", type=float, default=3.0,
                     help="clip the drawn durations from below (long-record runs)")
     ap.add_argument("--sweep-max-duration", type=float, default=20.0)
+    ap.add_argument("--effects", default=",".join(SWEPT), metavar="E1,E2",
+                    help="effects to sweep (default all)")
     ap.add_argument("--summarise", action="store_true",
                     help="only rewrite the tables from OUT_DIR/calibration.json")
     a = ap.parse_args()
     out = Path(a.out)
+    swept = tuple(e for e in a.effects.split(",") if e)
+    unknown = sorted(set(swept) - set(SWEPT))
+    if unknown:
+        sys.exit(f"calibration.py: --effects: unknown {', '.join(unknown)}; use some of "
+                 f"{', '.join(SWEPT)}")
     if a.summarise:
         saved = json.loads((out / "calibration.json").read_text())
         S, md = summarise(saved["records"], saved["summary"]["args"])
@@ -519,7 +529,7 @@ def main() -> None:
     half = (a.sweep + 1) // 2
     pick = rot[:half] + lin[:a.sweep - min(half, len(rot))]
     pick = pick + [r for r in ok if r not in pick][:a.sweep - len(pick)]
-    jobs = [(r["seed"], r, a.max_duration, a.min_duration) for r in pick]
+    jobs = [(r["seed"], r, a.max_duration, a.min_duration, swept) for r in pick]
     for done, res in enumerate(mapper(_sweep_job, jobs), 1):
         rows += res
         print(f"[{time.time() - t0:6.0f} s] sweep {done}/{len(jobs)} (seed {res[0]['seed']})",
