@@ -101,7 +101,20 @@ def _diagnose(case: dict[str, Any], rec: dict[str, np.ndarray], hold: dict[str, 
         "nrmse_before": d["fit"]["before"]["nrmse_force"],
         "nrmse_after": d["fit"]["after"]["nrmse_force"],
         "seconds": round(time.time() - t0, 2),
+        # the first step's trials (each candidate against the base) and the motor
+        # force's rms, for benches/sensitivity.py
+        "first_step": [{k: tr.get(k) for k in ("effect", "gain", "p", "positive", "blocks",
+                                               "ratio", "contrib", "accepted")}
+                       for tr in trials if tr.get("step") == 1],
+        "force_rms": _force_rms(case, rec),
     }
+
+
+def _force_rms(case: dict[str, Any], rec: dict[str, np.ndarray]) -> float:
+    """The motor force's rms [N] (N m on a rotary axis), from the recorded current."""
+    ax = case["believed"]["axis"]
+    kf = float(ax.get("force_constant", ax.get("torque_constant", 1.0)))
+    return float(kf * np.sqrt(np.mean(np.asarray(rec["i"]) ** 2)))
 
 
 def _mass_error(case: dict[str, Any]) -> float:

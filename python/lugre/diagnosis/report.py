@@ -169,7 +169,8 @@ class Diagnosis:
             "rebased": _plain(self.rebased),
             "trials": [
                 {k: _plain(v) for k, v in t.items() if k in (
-                    "step", "effect", "gain", "p", "positive", "contrib", "accepted", "why")}
+                    "step", "effect", "gain", "t", "p", "positive", "blocks", "ratio",
+                    "contrib", "accepted", "why")}
                 for t in self.trials
             ],
         }
