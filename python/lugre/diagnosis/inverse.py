@@ -126,7 +126,9 @@ def fit_inverse_dynamics(
     if not mm > 0:
         raise DataError(f"the inverse-dynamics fit gives a mass of {mm:.3g} "
                         f"{'kg m^2' if kind == 'rotary' else 'kg'}: the record does not "
-                        "excite the inertia; give the mass (--mass)")
+                        "excite the inertia, or a force that grows with the position (a "
+                        "spring, a cable, a weight) follows the acceleration against it; "
+                        "give the mass (--mass)")
     fcp, s2p, fcn, s2n = (float(b[off + k]) for k in range(4))
     dp = float(b[off + 4 + ng]) if vs is not None else 0.0
     dn = float(b[off + 5 + ng]) if vs is not None else 0.0
