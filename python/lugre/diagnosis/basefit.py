@@ -405,14 +405,22 @@ def identify(recording: Any, *, mass: float | None = None, force_constant: float
 
 def _passive(res: BaseFitResult) -> BaseFitResult:
     """The fit with sigma1 held at the passivity bound ``4*sigma2*fc/(fs - fc)`` of
-    its friction when it came out beyond it (a non-passive friction map can feed energy
-    into the axis; the record then also leaves sigma1 loose): said in its profile."""
+    its friction when it came out beyond it and the record leaves it loose (a
+    non-passive friction map can feed energy into the axis): said in its profile. The
+    bound is sufficient for passivity, not necessary: a sigma1 the record puts beyond
+    it, its whole interval too, is kept, and its profile carries the bound
+    (``passivity_bound``), which the fit's notes give beside it."""
     m = res.model
     if m.is_passive:
         return res
     bound = min(m.passivity_bound())
     prof = dict(res.profiles)
     p = dict(prof.get("sigma1") or {"ci95": [None, None]})
+    lo = (p.get("ci95") or [None, None])[0]
+    if p.get("determined") and lo is not None and lo > bound:
+        p["passivity_bound"] = bound
+        prof["sigma1"] = p
+        return replace(res, profiles=prof)
     p.update(value=bound, fitted=m.sigma1, determined=False, how="passivity bound")
     prof["sigma1"] = p
     return replace(res, model=m.with_friction(sigma1=bound), profiles=prof)

@@ -67,6 +67,8 @@ def _identification(fit: BaseFitResult, nrmse: float) -> dict[str, Any]:
         params[name] = {"value": float(p["value"]), "unit": fit_unit(name),
                         "ci95": [_num(ci[0]), _num(ci[1])],
                         "determined": bool(p["determined"]), "how": p["how"]}
+        if p.get("passivity_bound") is not None:
+            params[name]["passivity_bound"] = float(p["passivity_bound"])
     words, far = fit.floor_words()
     return {"nrmse_force": float(nrmse), "rms_force": fit.rms, "noise_floor": fit.noise,
             "floor_ratio": fit.floor_ratio, "far_from_floor": far, "summary": words,
@@ -83,6 +85,15 @@ def undetermined_notes(fit: BaseFitResult) -> list[str]:
 def _undetermined(fit: BaseFitResult) -> list[str]:
     out = []
     for name, p in fit.profiles.items():
+        if p.get("passivity_bound") is not None:
+            lo, hi = p["ci95"]
+            out.append(f"{label(name)} = {p['value']:.4g} {fit_unit(name)} lies beyond the "
+                       f"passivity bound 4*sigma2*fc/(fs - fc) = {p['passivity_bound']:.4g} "
+                       f"{fit_unit(name)} of the friction, and the record puts it there (95 % "
+                       f"interval {lo:.4g} to {hi:.4g}): kept. The bound is sufficient for "
+                       "passivity, not necessary; a simulation with this model may feed "
+                       "energy into the axis near the reversals, so check it against a "
+                       "record before a compensator relies on it")
         if p["determined"]:
             continue
         key = _key(name)
