@@ -83,7 +83,7 @@ class ForceRipple(Candidate):
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
         span = max(ctx.xrange[1] - ctx.xrange[0], 1e-9)
         ks = np.geomspace(1.5 / span, max(Cogging.kmax(ctx), 2.0 / span), 6)
-        amps_ = periodic_sizes(sizes, [self.columns(1.0 / k, ctx) for k in ks])
+        amps_ = periodic_sizes(sizes, lambda p: self.columns(p, ctx), [1.0 / k for k in ks])
         seen = np.isfinite(amps_)
         b = share(float(np.max(amps_[seen]))) if seen.any() else math.inf
         return hide(self.effect, b, "-", f"a {U.force_words()} ripple "
