@@ -279,9 +279,11 @@ impl Record {
     /// The friction scale, the effect forces and the rise of the friction levels on
     /// the load of a `resonance`.
     fn load_forces(&self, model: &Model) -> LoadForces {
+        // (no force effect: none, the same numbers as zeros at a fraction of the memory)
+        let forces = model.effects.iter().any(Effect::is_force);
         LoadForces {
             scale: self.friction_scale(model),
-            extra: self.effect_force(model),
+            extra: forces.then(|| self.effect_force(model)),
             level: self.friction_level(model),
         }
     }
@@ -290,7 +292,7 @@ impl Record {
     fn coupling_options<'a>(&self, load: &'a LoadForces) -> CouplingOptions<'a> {
         CouplingOptions {
             scale: load.scale.as_deref(),
-            extra: Some(&load.extra),
+            extra: load.extra.as_deref(),
             level: load.level.as_deref(),
             z0: 0.0,
             substeps: COUPLING_SUBSTEPS,
@@ -492,8 +494,8 @@ impl Record {
 struct LoadForces {
     /// The friction scale (`None`: 1).
     scale: Option<Vec<f64>>,
-    /// The effect forces [N].
-    extra: Vec<f64>,
+    /// The effect forces [N] (`None`: no force effect).
+    extra: Option<Vec<f64>>,
     /// The rise of the friction levels (`None`: 0).
     level: Option<Vec<f64>>,
 }

@@ -127,8 +127,8 @@ def _column_key(c: Candidate, h: Any, step: int = 1) -> tuple[Any, ...]:
 
 def prefetch(c: Candidate, hs: Any, ctx: Context) -> None:
     """Build the missing columns of grid points ``hs`` in parallel batches, when the
-    candidate can (``columns_many``), into the cache :func:`make_term` reads (the rows
-    the scorers read only)."""
+    candidate can (``columns_many``, which returns the rows the scorers read only),
+    into the cache :func:`make_term` reads."""
     many = getattr(c, "columns_many", None)
     if many is None:
         return
@@ -139,8 +139,8 @@ def prefetch(c: Candidate, hs: Any, ctx: Context) -> None:
     per = max(1, _BATCH_BYTES // (8 * max(len(ctx.sig), 1)))
     for i in range(0, len(todo), per):
         chunk = todo[i:i + per]
-        cols = many(chunk, ctx)
+        cols = many(chunk, ctx, step)
         if cols is None:
             return
         for h, X in zip(chunk, cols):
-            cache[_column_key(c, h, step)] = rows_of(X, step)
+            cache[_column_key(c, h, step)] = X

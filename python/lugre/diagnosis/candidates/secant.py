@@ -52,14 +52,16 @@ class _Secant(Candidate):
         return (self._r_base(ctx) - R.residual(self._with(h, ctx), self._signals(ctx))
                 )[:, None]
 
-    def columns_many(self, hs: list[Any], ctx: Context) -> list[np.ndarray] | None:
+    def columns_many(self, hs: list[Any], ctx: Context, step: int = 1
+                     ) -> list[np.ndarray] | None:
         """The columns of several grid points at once (the kernel runs them in
-        parallel), or None when this candidate builds its columns otherwise."""
+        parallel), or None when this candidate builds its columns otherwise; with
+        ``step``, every ``step``-th row only (:func:`~.base.rows_of`, the same numbers)."""
         if type(self).columns is not _Secant.columns:
             return None
-        r0 = self._r_base(ctx)
+        r0 = self._r_base(ctx)[::step]
         rs = self._signals(ctx).kernel.residuals([self._with(h, ctx) for h in hs])
-        return [(r0 - rs[:, j])[:, None] for j in range(len(hs))]
+        return [(r0 - rs[::step, j])[:, None] for j in range(len(hs))]
 
     def columns_of(self, hs: list[Any], ctx: Context) -> list[np.ndarray]:
         """The single columns of grid points ``hs`` (in parallel when the kernel can)."""
