@@ -24,7 +24,7 @@ mod fit;
 mod sensitivities;
 mod spectrum;
 
-pub use filter::{moving_median, Lowpass, LANES};
+pub use filter::{moving_median, Lanes, Lowpass, LANES};
 pub use fit::{fit_base, BaseFit, BaseFitOptions, FitParam};
 pub use sensitivities::{BaseParam, Sensitivities};
 pub use spectrum::{position_sums, PositionSums, MAX_FREQUENCIES, RESEED};
@@ -143,6 +143,12 @@ impl Record {
     /// The parallel low-pass of a signal of the record's length.
     pub fn filt(&self, y: &[f64]) -> Vec<f64> {
         self.filter.filtfilt(y)
+    }
+
+    /// [`Lowpass::filtfilt_lanes`] of up to [`LANES`] signals of the record's length,
+    /// sample `k` of signal `l` read as `y(l, k)`.
+    pub fn filt_lanes(&self, width: usize, y: impl Fn(usize, usize) -> f64) -> Lanes {
+        self.filter.filtfilt_lanes(self.len(), width, y)
     }
 
     /// [`Record::filt`] of several signals of the record's length, side by side
