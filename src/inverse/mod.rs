@@ -478,21 +478,25 @@ impl Record {
     }
 
     /// The residuals of models (`ms[k]`) from their unfiltered model forces
-    /// ([`Record::model_force_raw`], by index `k`), the low-passes side by side.
-    fn finish(&self, ms: &[&Model], raw: Vec<(usize, (f64, Vec<f64>))>) -> Vec<(usize, Vec<f64>)> {
-        let ys: Vec<&[f64]> = raw.iter().map(|(_, (_, f))| f.as_slice()).collect();
-        let filtered = self.filter.filtfilt_many(&ys);
-        raw.iter()
-            .zip(&filtered)
-            .map(|((k, (ma, _)), f)| {
+    /// ([`Record::model_force_raw`], by index `k`), the low-passes side by side, each
+    /// residual written over its model force (no copy of the record's length more).
+    fn finish(
+        &self,
+        ms: &[&Model],
+        mut raw: Vec<(usize, (f64, Vec<f64>))>,
+    ) -> Vec<(usize, Vec<f64>)> {
+        for chunk in raw.chunks_mut(LANES) {
+            let filtered = self.filt_lanes(chunk.len(), |l, i| chunk[l].1 .1[i]);
+            for (l, (k, (ma, y))) in chunk.iter_mut().enumerate() {
                 // motor force minus what the model needs, `ma*a + f`
-                let mut r = self.motor_force(ms[*k]);
-                for ((r, a), f) in r.iter_mut().zip(&self.a).zip(f) {
-                    *r -= ma * a + f;
+                let motor = self.actuator_force(ms[*k]).map(|f| self.filt(&f));
+                let motor = motor.as_deref().unwrap_or(&self.fm_f);
+                for (i, ((r, m), a)) in y.iter_mut().zip(motor).zip(&self.a).enumerate() {
+                    *r = m - (*ma * a + filtered.get(l, i));
                 }
-                (*k, r)
-            })
-            .collect()
+            }
+        }
+        raw.into_iter().map(|(k, (_, r))| (k, r)).collect()
     }
 }
 
