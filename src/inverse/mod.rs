@@ -163,6 +163,17 @@ impl Record {
             .collect()
     }
 
+    /// [`Record::filt_many`] in place: each signal replaced by its low-pass.
+    pub fn filt_in_place(&self, ys: &mut [Vec<f64>]) {
+        use rayon::prelude::*;
+        ys.par_chunks_mut(LANES).for_each(|chunk| {
+            let f = self.filt_lanes(chunk.len(), |l, k| chunk[l][k]);
+            for (l, y) in chunk.iter_mut().enumerate() {
+                y.iter_mut().zip(f.lane(l)).for_each(|(y, v)| *y = v);
+            }
+        });
+    }
+
     /// Product of the `position_friction` and `drift` scales, in the order of the
     /// effects, or `None` without them.
     pub fn friction_scale(&self, model: &Model) -> Option<Vec<f64>> {
