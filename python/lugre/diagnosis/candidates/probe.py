@@ -11,12 +11,12 @@ import numpy as np
 from ... import units as U
 from .. import residual as R
 
-__all__ = ["AT_ONCE", "amps", "hide", "in_batches", "rate_noise_power", "refit_on", "reversals", "share", "start_of",
-           "two_ways", "under"]
+__all__ = ["AT_ONCE", "amps", "hide", "in_batches", "rate_noise_power", "refit_on",
+           "reversals", "share", "start_of", "two_ways", "under"]
 
 
-#: Columns of a limit built and judged at once: on a long record each is 8 MB a million
-#: samples, and its size is its own (the same numbers in any grouping).
+#: Columns of a limit built and judged at once: each is 8 MB a million samples, and its
+#: size is its own (the same numbers in any grouping).
 AT_ONCE = 4
 
 

@@ -109,8 +109,8 @@ class Resonance(_Secant):
                         experiment="the filter band is too narrow; record faster")
         fs = sorted({h[0] for h in g})
         pts = [(f, 0.05, 0.5) for f in fs]
-        sz = list(in_batches(lambda ps: sizes(self.columns_of(ps, ctx)), pts))
         # (in units of the half-mass load's force)
+        sz = list(in_batches(lambda ps: sizes(self.columns_of(ps, ctx)), pts))
         hidden = [f for f, s in zip(fs, sz) if s > 1.0]
         if not hidden:
             # the load's force grows about in proportion to its share of the mass
