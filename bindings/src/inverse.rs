@@ -6,7 +6,7 @@ use lugre::error::Error;
 use lugre::estimate::Weighting;
 use lugre::inverse::{
     fit_base as base_fit, moving_median as median, position_sums as sums, BaseFitOptions,
-    BaseParam, Lowpass, Record, LANES,
+    BaseParam, Lanes, Lowpass, Record, LANES,
 };
 use lugre::servo::Model;
 use numpy::ndarray::Array2;
@@ -176,19 +176,29 @@ impl PyInverseRecord {
                 ),
             ));
         }
-        // a few columns at a time, each written into the result as it is filtered: the
-        // matrix of a long record is hundreds of MB, and copies of all its columns in and
-        // out would triple that (the same numbers: every column is filtered on its own)
+        // LANES columns at a time read where they are and written into the result as
+        // they are filtered, as many at once as there are threads: the matrix of a long
+        // record is hundreds of MB, and copies of its columns in and out would triple
+        // that (the same numbers: every column is filtered on its own)
         let m = a.ncols();
         let out = py.detach(|| {
+            use rayon::prelude::*;
             let mut out = Array2::<f64>::zeros((n, m));
-            let wave = 2 * LANES;
-            for j0 in (0..m).step_by(wave) {
-                let j1 = (j0 + wave).min(m);
-                let cols: Vec<Vec<f64>> = (j0..j1).map(|j| a.column(j).to_vec()).collect();
-                for (j, c) in (j0..j1).zip(self.rec.filt_many(&cols)) {
-                    out.column_mut(j)
-                        .assign(&numpy::ndarray::ArrayView1::from(&c));
+            let starts: Vec<usize> = (0..m).step_by(LANES).collect();
+            for wave in starts.chunks(rayon::current_num_threads().max(1)) {
+                let done: Vec<(usize, Lanes)> = wave
+                    .par_iter()
+                    .map(|&j0| {
+                        let w = LANES.min(m - j0);
+                        (j0, self.rec.filt_lanes(w, |l, k| a[[k, j0 + l]]))
+                    })
+                    .collect();
+                for (j0, f) in done {
+                    for l in 0..f.width() {
+                        for (o, v) in out.column_mut(j0 + l).iter_mut().zip(f.lane(l)) {
+                            *o = v;
+                        }
+                    }
                 }
             }
             out

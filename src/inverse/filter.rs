@@ -215,34 +215,63 @@ impl Lowpass {
         }
         for (n, group) in groups {
             for chunk in group.chunks(LANES) {
-                if n == 0 || chunk.len() == 1 {
-                    for &j in chunk {
-                        out[j] = self.filtfilt(ys[j]);
-                    }
+                if chunk.len() == 1 {
+                    out[chunk[0]] = self.filtfilt(ys[chunk[0]]);
                     continue;
                 }
-                // the extensions side by side, sample by sample (zeros in unused lanes)
-                let edge = self.padlen.min(n - 1);
-                let mut buf = vec![[0.0f64; LANES]; n + 2 * edge];
+                let f = self.filtfilt_lanes(n, chunk.len(), |l, k| ys[chunk[l]][k]);
                 for (l, &j) in chunk.iter().enumerate() {
-                    let y = ys[j];
-                    let (first, last) = (y[0], y[n - 1]);
-                    for k in 0..edge {
-                        buf[k][l] = 2.0 * first - y[edge - k];
-                        buf[edge + n + k][l] = 2.0 * last - y[n - 2 - k];
-                    }
-                    for (b, &v) in buf[edge..edge + n].iter_mut().zip(y) {
-                        b[l] = v;
-                    }
-                }
-                self.run_lanes(&mut buf, false);
-                self.run_lanes(&mut buf, true);
-                for (l, &j) in chunk.iter().enumerate() {
-                    out[j] = buf[edge..edge + n].iter().map(|b| b[l]).collect();
+                    out[j] = f.lane(l).collect();
                 }
             }
         }
         out
+    }
+
+    /// [`Lowpass::filtfilt`] of up to [`LANES`] signals of length `n`, sample `k` of
+    /// signal `l` read as `y(l, k)` (a matrix's column, where it is), side by side
+    /// when there are several and the filter has 1 to 4 sections ([`Lowpass::run_n`]
+    /// on every lane at once: the same numbers lane by lane), one by one otherwise.
+    ///
+    /// # Panics
+    /// When `width` exceeds [`LANES`].
+    pub fn filtfilt_lanes(&self, n: usize, width: usize, y: impl Fn(usize, usize) -> f64) -> Lanes {
+        assert!(width <= LANES, "at most {LANES} signals side by side");
+        let ns = self.sections.len();
+        if n == 0 || width < 2 || !(1..=4).contains(&ns) {
+            let one = (0..width)
+                .map(|l| self.filtfilt(&(0..n).map(|k| y(l, k)).collect::<Vec<f64>>()))
+                .collect();
+            return Lanes {
+                buf: Vec::new(),
+                one,
+                edge: 0,
+                n,
+                width,
+            };
+        }
+        // the extensions side by side, sample by sample (zeros in unused lanes)
+        let edge = self.padlen.min(n - 1);
+        let mut buf = vec![[0.0f64; LANES]; n + 2 * edge];
+        for l in 0..width {
+            let (first, last) = (y(l, 0), y(l, n - 1));
+            for k in 0..edge {
+                buf[k][l] = 2.0 * first - y(l, edge - k);
+                buf[edge + n + k][l] = 2.0 * last - y(l, n - 2 - k);
+            }
+            for (k, b) in buf[edge..edge + n].iter_mut().enumerate() {
+                b[l] = y(l, k);
+            }
+        }
+        self.run_lanes(&mut buf, false);
+        self.run_lanes(&mut buf, true);
+        Lanes {
+            buf,
+            one: Vec::new(),
+            edge,
+            n,
+            width,
+        }
     }
 
     /// The odd extension of `y` (not empty) by `edge = min(padlen, len - 1)` samples at
@@ -337,6 +366,42 @@ fn step_lanes<const N: usize>(
 }
 
 /// The signal of `n` samples in an extension by `edge` samples at both ends.
+/// Signals filtered side by side by [`Lowpass::filtfilt_lanes`], stored sample by
+/// sample with their extensions.
+#[derive(Debug, Clone)]
+pub struct Lanes {
+    /// The signals side by side, extensions included (empty when filtered one by one).
+    buf: Vec<[f64; LANES]>,
+    /// The signals filtered one by one.
+    one: Vec<Vec<f64>>,
+    edge: usize,
+    n: usize,
+    width: usize,
+}
+
+impl Lanes {
+    /// Number of signals.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Sample `k` of the filtered signal `l` (`l < width`, `k < n`).
+    #[inline]
+    pub fn get(&self, l: usize, k: usize) -> f64 {
+        assert!(l < self.width, "lane {l} of {}", self.width);
+        if self.buf.is_empty() {
+            self.one[l][k]
+        } else {
+            self.buf[self.edge + k][l]
+        }
+    }
+
+    /// The filtered signal `l` (`l < width`), sample by sample.
+    pub fn lane(&self, l: usize) -> impl Iterator<Item = f64> + '_ {
+        (0..self.n).map(move |k| self.get(l, k))
+    }
+}
+
 fn cut(mut ext: Vec<f64>, edge: usize, n: usize) -> Vec<f64> {
     ext.drain(..edge);
     ext.truncate(n);
@@ -492,6 +557,30 @@ mod tests {
             }
         }
         assert!(Lowpass::identity().filtfilt_many(&refs)[3] == ys[3]);
+        // read where they are (the columns of a row-major matrix), 1 to 4 at a time,
+        // with 2 and 5 sections (5: one at a time) and none
+        let n = 300;
+        let rows: Vec<[f64; 4]> = (0..n)
+            .map(|k| core::array::from_fn(|j| sig(j, n)[k]))
+            .collect();
+        for f in [
+            Lowpass::new(vec![s; 2], 9).unwrap(),
+            Lowpass::new(vec![s; 5], 9).unwrap(),
+            Lowpass::identity(),
+        ] {
+            for width in 1..=LANES {
+                let got = f.filtfilt_lanes(n, width, |l, k| rows[k][l]);
+                assert_eq!(got.width(), width);
+                for l in 0..width {
+                    let one = f.filtfilt(&sig(l, n));
+                    assert!(one
+                        .iter()
+                        .zip(got.lane(l))
+                        .all(|(a, b)| a.to_bits() == b.to_bits()));
+                    assert_eq!(got.lane(l).count(), n);
+                }
+            }
+        }
     }
 
     #[test]

@@ -345,25 +345,39 @@ impl Problem<'_> {
         r.iter().zip(w).map(|(r, w)| w * r * r).sum()
     }
 
-    /// `(J^T W J, J^T W r)`.
+    /// `(J^T W J, J^T W r)`, every product summed over the samples in their order in
+    /// one pass (the sums of one pass per product, with their rounding).
     fn normal(j: &[Vec<f64>], w: &[f64], r: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
         let q = j.len();
-        let mut a = DMatrix::zeros(q, q);
-        let mut b = DVector::zeros(q);
-        for i in 0..q {
-            b[i] = j[i].iter().zip(w).zip(r).map(|((x, w), r)| x * w * r).sum();
-            for k in 0..=i {
-                let s: f64 = j[i]
-                    .iter()
-                    .zip(&j[k])
-                    .zip(w)
-                    .map(|((x, y), w)| x * y * w)
-                    .sum();
-                a[(i, k)] = s;
-                a[(k, i)] = s;
+        let n = j
+            .iter()
+            .map(Vec::len)
+            .fold(w.len().min(r.len()), usize::min);
+        // (`-0.0`: the start of a float `Iterator::sum`)
+        let mut b = vec![-0.0f64; q];
+        let mut lower = vec![-0.0f64; q * (q + 1) / 2];
+        for t in 0..n {
+            let (wt, rt) = (w[t], r[t]);
+            let mut p = 0;
+            for i in 0..q {
+                let x = j[i][t];
+                b[i] += x * wt * rt;
+                for col in &j[..=i] {
+                    lower[p] += x * col[t] * wt;
+                    p += 1;
+                }
             }
         }
-        (a, b)
+        let mut a = DMatrix::zeros(q, q);
+        let mut p = 0;
+        for i in 0..q {
+            for k in 0..=i {
+                a[(i, k)] = lower[p];
+                a[(k, i)] = lower[p];
+                p += 1;
+            }
+        }
+        (a, DVector::from_vec(b))
     }
 
     fn run(&mut self, start: &Model, max_iter: usize) -> Result<Option<Run>> {

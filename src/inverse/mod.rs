@@ -24,7 +24,7 @@ mod fit;
 mod sensitivities;
 mod spectrum;
 
-pub use filter::{moving_median, Lowpass, LANES};
+pub use filter::{moving_median, Lanes, Lowpass, LANES};
 pub use fit::{fit_base, BaseFit, BaseFitOptions, FitParam};
 pub use sensitivities::{BaseParam, Sensitivities};
 pub use spectrum::{position_sums, PositionSums, MAX_FREQUENCIES, RESEED};
@@ -145,6 +145,12 @@ impl Record {
         self.filter.filtfilt(y)
     }
 
+    /// [`Lowpass::filtfilt_lanes`] of up to [`LANES`] signals of the record's length,
+    /// sample `k` of signal `l` read as `y(l, k)`.
+    pub fn filt_lanes(&self, width: usize, y: impl Fn(usize, usize) -> f64) -> Lanes {
+        self.filter.filtfilt_lanes(self.len(), width, y)
+    }
+
     /// [`Record::filt`] of several signals of the record's length, side by side
     /// ([`Lowpass::filtfilt_many`]) and in parallel (rayon).
     pub fn filt_many(&self, ys: &[Vec<f64>]) -> Vec<Vec<f64>> {
@@ -155,6 +161,17 @@ impl Record {
                 self.filter.filtfilt_many(&refs)
             })
             .collect()
+    }
+
+    /// [`Record::filt_many`] in place: each signal replaced by its low-pass.
+    pub fn filt_in_place(&self, ys: &mut [Vec<f64>]) {
+        use rayon::prelude::*;
+        ys.par_chunks_mut(LANES).for_each(|chunk| {
+            let f = self.filt_lanes(chunk.len(), |l, k| chunk[l][k]);
+            for (l, y) in chunk.iter_mut().enumerate() {
+                y.iter_mut().zip(f.lane(l)).for_each(|(y, v)| *y = v);
+            }
+        });
     }
 
     /// Product of the `position_friction` and `drift` scales, in the order of the
@@ -279,9 +296,11 @@ impl Record {
     /// The friction scale, the effect forces and the rise of the friction levels on
     /// the load of a `resonance`.
     fn load_forces(&self, model: &Model) -> LoadForces {
+        // (no force effect: none, the same numbers as zeros at a fraction of the memory)
+        let forces = model.effects.iter().any(Effect::is_force);
         LoadForces {
             scale: self.friction_scale(model),
-            extra: self.effect_force(model),
+            extra: forces.then(|| self.effect_force(model)),
             level: self.friction_level(model),
         }
     }
@@ -290,7 +309,7 @@ impl Record {
     fn coupling_options<'a>(&self, load: &'a LoadForces) -> CouplingOptions<'a> {
         CouplingOptions {
             scale: load.scale.as_deref(),
-            extra: Some(&load.extra),
+            extra: load.extra.as_deref(),
             level: load.level.as_deref(),
             z0: 0.0,
             substeps: COUPLING_SUBSTEPS,
@@ -470,21 +489,25 @@ impl Record {
     }
 
     /// The residuals of models (`ms[k]`) from their unfiltered model forces
-    /// ([`Record::model_force_raw`], by index `k`), the low-passes side by side.
-    fn finish(&self, ms: &[&Model], raw: Vec<(usize, (f64, Vec<f64>))>) -> Vec<(usize, Vec<f64>)> {
-        let ys: Vec<&[f64]> = raw.iter().map(|(_, (_, f))| f.as_slice()).collect();
-        let filtered = self.filter.filtfilt_many(&ys);
-        raw.iter()
-            .zip(&filtered)
-            .map(|((k, (ma, _)), f)| {
+    /// ([`Record::model_force_raw`], by index `k`), the low-passes side by side, each
+    /// residual written over its model force (no copy of the record's length more).
+    fn finish(
+        &self,
+        ms: &[&Model],
+        mut raw: Vec<(usize, (f64, Vec<f64>))>,
+    ) -> Vec<(usize, Vec<f64>)> {
+        for chunk in raw.chunks_mut(LANES) {
+            let filtered = self.filt_lanes(chunk.len(), |l, i| chunk[l].1 .1[i]);
+            for (l, (k, (ma, y))) in chunk.iter_mut().enumerate() {
                 // motor force minus what the model needs, `ma*a + f`
-                let mut r = self.motor_force(ms[*k]);
-                for ((r, a), f) in r.iter_mut().zip(&self.a).zip(f) {
-                    *r -= ma * a + f;
+                let motor = self.actuator_force(ms[*k]).map(|f| self.filt(&f));
+                let motor = motor.as_deref().unwrap_or(&self.fm_f);
+                for (i, ((r, m), a)) in y.iter_mut().zip(motor).zip(&self.a).enumerate() {
+                    *r = m - (*ma * a + filtered.get(l, i));
                 }
-                (*k, r)
-            })
-            .collect()
+            }
+        }
+        raw.into_iter().map(|(k, (_, r))| (k, r)).collect()
     }
 }
 
@@ -492,8 +515,8 @@ impl Record {
 struct LoadForces {
     /// The friction scale (`None`: 1).
     scale: Option<Vec<f64>>,
-    /// The effect forces [N].
-    extra: Vec<f64>,
+    /// The effect forces [N] (`None`: no force effect).
+    extra: Option<Vec<f64>>,
     /// The rise of the friction levels (`None`: 0).
     level: Option<Vec<f64>>,
 }

@@ -182,10 +182,10 @@ impl Record {
             z = p.advance_z(z, u, gh, self.dt);
         }
         let nonzero = cols.iter().map(|c| c.iter().any(|&x| x != 0.0)).collect();
-        let columns = self.filt_many(&cols);
+        self.filt_in_place(&mut cols);
         Sensitivities {
             force,
-            columns,
+            columns: cols,
             nonzero,
         }
     }

@@ -24,8 +24,10 @@ from .scoring import Evaluation, rows_of
 __all__ = ["contribution_rms", "contribution_rows", "make_term", "prefetch", "reads_rows",
            "release_columns", "whole"]
 
-#: Most column bytes built in one parallel batch.
-_BATCH_BYTES = 64 * 2**20
+#: Most column bytes built in one parallel batch (four grid points of a million
+#: samples: the batch's residuals and the filter's buffers beside them add about
+#: 50 MB to the search's peak; eight, twice that).
+_BATCH_BYTES = 32 * 2**20
 
 #: Rows of a column matrix multiplied at once for its Gram matrix.
 _GRAM_ROWS = 65536
@@ -111,13 +113,21 @@ def whole(terms: list[Term], ev: Evaluation, ctx: Context) -> tuple[list[Term], 
 
 
 def release_columns(ctx: Context) -> None:
-    """Drop the columns :func:`make_term` and :func:`prefetch` keep on ``ctx``.
+    """Drop the columns :func:`make_term` and :func:`prefetch` keep on ``ctx``, and
+    what the candidates keep there to make them (a base residual, a record with another
+    motor force: :data:`_MADE_WITH`).
 
     The search profiles the same grids at every step and in its later runs (a refusal,
     a look-alike), so the columns stay while it lasts; after it nothing reads them (the
     joint refit builds its own). The terms chosen keep their own columns."""
-    for key in [k for k in ctx.extra if isinstance(k, tuple) and k[:1] == ("cache",)]:
+    for key in [k for k in ctx.extra if isinstance(k, tuple) and k[:1] in _MADE_WITH]:
         del ctx.extra[key]
+
+
+#: Keys of ``ctx.extra`` that hold columns or what they are made from, by their first
+#: element: the column cache, a secant's base residual, a record with the force the
+#: model needs (:class:`~lugre.diagnosis.candidates.drive.LoadFriction`).
+_MADE_WITH = (("cache",), ("r_base",), ("needed_force",))
 
 
 def _column_key(c: Candidate, h: Any, step: int = 1) -> tuple[Any, ...]:
@@ -127,8 +137,8 @@ def _column_key(c: Candidate, h: Any, step: int = 1) -> tuple[Any, ...]:
 
 def prefetch(c: Candidate, hs: Any, ctx: Context) -> None:
     """Build the missing columns of grid points ``hs`` in parallel batches, when the
-    candidate can (``columns_many``), into the cache :func:`make_term` reads (the rows
-    the scorers read only)."""
+    candidate can (``columns_many``, which returns the rows the scorers read only),
+    into the cache :func:`make_term` reads."""
     many = getattr(c, "columns_many", None)
     if many is None:
         return
@@ -139,8 +149,8 @@ def prefetch(c: Candidate, hs: Any, ctx: Context) -> None:
     per = max(1, _BATCH_BYTES // (8 * max(len(ctx.sig), 1)))
     for i in range(0, len(todo), per):
         chunk = todo[i:i + per]
-        cols = many(chunk, ctx)
+        cols = many(chunk, ctx, step)
         if cols is None:
             return
         for h, X in zip(chunk, cols):
-            cache[_column_key(c, h, step)] = rows_of(X, step)
+            cache[_column_key(c, h, step)] = X

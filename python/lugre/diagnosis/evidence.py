@@ -4,6 +4,7 @@ its own part, :meth:`~lugre.diagnosis.candidates.Candidate.limit`), and the verd
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import partial
 from typing import Any
 
@@ -239,6 +240,8 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
     """
     found_terms = list(terms or [])
     sig = ctx.sig
+    # the rows the scorer reads: a limit may keep its fits' columns at those rows only
+    ctx = replace(ctx, extra={**ctx.extra, "rows_step": scorer.step})
 
     def sizes(Xs: list[np.ndarray], effect: str, timing: bool,
               fits: list[Term | None] | None = None) -> np.ndarray:

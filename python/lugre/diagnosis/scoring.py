@@ -29,6 +29,7 @@ import numpy as np
 
 from . import dsp
 from .candidates import Term
+from .candidates.base import rows_of
 
 __all__ = ["Evaluation", "Scorer", "accept", "accept_many", "block_evidence", "block_gains",
            "compare", "rows_count", "rows_of", "told_apart"]
@@ -71,11 +72,6 @@ class Evaluation:
 def rows_count(n: int, step: int) -> int:
     """Rows ``0, step, 2*step, ...`` of ``n`` samples."""
     return -(-n // step)
-
-
-def rows_of(X: np.ndarray, step: int) -> np.ndarray:
-    """Every ``step``-th row of ``X`` as its own array (the full one can be freed)."""
-    return X if step <= 1 else np.ascontiguousarray(X[::step])
 
 
 class Scorer:

@@ -82,7 +82,7 @@ class Weighing:
         if free:
             return BaseSet(self.sc_free, self.J, self.names, self.tol)
         h = self.held
-        # (the held scorer's own copy of those columns: a long record's are 60 MB)
+        # (the held scorer's columns: not taken again, a long record's are 60 MB)
         return BaseSet(self.sc_held, self.sc_held.J, [self.names[k] for k in h], self.tol[h])
 
     def block_sse(self, m: Model, sig: R.Signals) -> np.ndarray:
@@ -113,7 +113,9 @@ def weigh(prep: Prepared, model: Model, r0: np.ndarray, opts: Options) -> Weighi
     tol = tol * float(opts.tolerance)
     held = [k for k, n in enumerate(names) if n not in B.PRESLIDING]
     ctx.extra["rows_step"] = step
-    j_held = J[:, held]
+    # (a view when the held columns are side by side: a long record's are 60 MB)
+    j_held = J[:, held[0]:held[-1] + 1] if held == list(range(held[0], held[-1] + 1)) \
+        else J[:, held]
     noise, s2 = variance_unit(r0, j_held, tol[held], sig, opts.blocks, step)
     sc_held = Scorer(r0, j_held, tol[held], sig.mask, s2, opts.blocks, step=step)
     sc_free = Scorer(r0, J, tol, sig.mask, s2, opts.blocks, step=step)

@@ -12,7 +12,7 @@ from ...model import Model
 from ..residual import Signals, base_friction
 
 __all__ = ["Candidate", "Context", "FindingView", "Said", "Term", "by", "by_current",
-           "grid_interval", "objects"]
+           "grid_interval", "objects", "rows_of"]
 
 
 @dataclass
@@ -231,6 +231,11 @@ def objects(items: list[Any]) -> np.ndarray:
     out = np.empty(len(items), dtype=object)
     out[:] = items
     return out
+
+
+def rows_of(X: np.ndarray, step: int) -> np.ndarray:
+    """Every ``step``-th row of ``X`` as its own array (the full one can be freed)."""
+    return X if step <= 1 else np.ascontiguousarray(X[::step])
 
 
 def grid_interval(values: dict[str, np.ndarray], ok: np.ndarray) -> dict[str, list[float]]:

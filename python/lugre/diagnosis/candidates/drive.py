@@ -84,7 +84,7 @@ class ForceRipple(Candidate):
         span = max(ctx.xrange[1] - ctx.xrange[0], 1e-9)
         ks = np.geomspace(1.5 / span, max(Cogging.kmax(ctx), 2.0 / span), 6)
         amps_ = np.array([share(a) for a in periodic_sizes(
-            sizes, [self.columns(1.0 / k, ctx) for k in ks])])
+            sizes, lambda p: self.columns(p, ctx), [1.0 / k for k in ks])])
         seen = np.isfinite(amps_)
         b = float(np.max(amps_[seen])) if seen.any() else math.inf
         return {**hide(self.effect, b, "-", f"a {U.force_words()} ripple " + pitch_bands(

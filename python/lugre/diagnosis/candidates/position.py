@@ -10,8 +10,8 @@ import numpy as np
 from ... import units as U
 from ...vocabulary import COGGING, GRAVITY, OFFSET, POSITION_FRICTION
 from ..residual import position_sums
-from .base import Candidate, Context, Term, by
-from .probe import FixedInPosition, hide, share, under
+from .base import Candidate, Context, Term, by, rows_of
+from .probe import AT_ONCE, FixedInPosition, hide, in_batches, share, under
 
 __all__ = ["Cogging", "Gravity", "PositionFriction"]
 
@@ -58,13 +58,18 @@ class Gravity(FixedInPosition, Candidate):
                     experiment="slow moves over a large part of a turn in both directions")
 
 
-def periodic_sizes(sizes: Any, cols: list[np.ndarray]) -> np.ndarray:
+def periodic_sizes(sizes: Any, columns: Any, pitches: list[float]) -> np.ndarray:
     """Per pitch, the smallest amplitude the search would name at any phase: the
     larger of the sine's and the cosine's, each judged with both columns free, as the
-    search fits them (``cols``: the sine and cosine columns of each pitch)."""
-    fits = [Term(cand=None, h=None, X=X) for X in cols]
-    both = sizes([X[:, j] for X in cols for j in (0, 1)], fits=[f for f in fits for _ in (0, 1)])
-    return np.max(np.asarray(both, float).reshape(len(cols), 2), axis=1)
+    search fits them (``columns(pitch)``: the sine and cosine columns of a pitch, built
+    a few pitches at a time)."""
+    def judge(ps: list[float]) -> np.ndarray:
+        cols = [columns(p) for p in ps]
+        fits = [Term(cand=None, h=None, X=X) for X in cols]
+        both = sizes([X[:, j] for X in cols for j in (0, 1)],
+                     fits=[f for f in fits for _ in (0, 1)])
+        return np.max(np.asarray(both, float).reshape(len(cols), 2), axis=1)
+    return in_batches(judge, list(pitches), AT_ONCE // 2)
 
 
 def by_pitch(ks: np.ndarray, amps: np.ndarray, scale: float = 1.0) -> dict[str, Any]:
@@ -180,7 +185,7 @@ class Cogging(FixedInPosition, Candidate):
         span = ctx.xrange[1] - ctx.xrange[0]
         kmax = self.kmax(ctx)
         ks = np.geomspace(1.5 / max(span, 1e-9), max(kmax, 2.0 / max(span, 1e-9)), 8)
-        amps = periodic_sizes(sizes, [self.columns(1.0 / k, ctx) for k in ks])
+        amps = periodic_sizes(sizes, lambda p: self.columns(p, ctx), [1.0 / k for k in ks])
         seen = np.isfinite(amps)
         b = float(np.max(amps[seen])) if seen.any() else float("inf")
         blind = ""
@@ -217,15 +222,23 @@ class PositionFriction(Candidate):
         """The hat of each knot times the Coulomb/static friction, low-passed; built and
         filtered a few columns at a time into the result (on a long record the 25
         columns are 200 MB, and the hats and their product whole would triple it)."""
+        out = np.empty((ctx.sig.x.size, self.knots(ctx).size))
+        for js, cols in self._hats(ctx):
+            out[:, js] = cols
+        return out
+
+    def _hats(self, ctx: Context) -> Any:
+        """The columns of :meth:`columns` a few at a time: ``(slice, columns)``."""
         kn = self.knots(ctx)
         x = np.clip(ctx.sig.x, kn[0], kn[-1])
         eye = np.eye(kn.size)
-        out = np.empty((x.size, kn.size))
         for j0 in range(0, kn.size, _AT_ONCE):
-            js = range(j0, min(j0 + _AT_ONCE, kn.size))
-            hats = np.column_stack([np.interp(x, kn, eye[j]) for j in js])
-            out[:, js.start:js.stop] = ctx.sig.filt(hats * ctx.fcs[:, None])
-        return out
+            js = slice(j0, min(j0 + _AT_ONCE, kn.size))
+            hats = np.empty((x.size, js.stop - js.start), order="F")  # (columns whole)
+            for i, j in enumerate(range(js.start, js.stop)):
+                hats[:, i] = np.interp(x, kn, eye[j])
+            hats *= ctx.fcs[:, None]
+            yield js, ctx.sig.filt(hats)
 
     def prior_tol(self, h: Any, ctx: Context) -> np.ndarray | None:
         return np.full(self.knots(ctx).size, 0.3)
@@ -249,10 +262,17 @@ class PositionFriction(Candidate):
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
         # a change over a tenth of the stroke each side of the mean position, as the
         # search reads it: with every knot's hat free within its prior
-        hats = self.columns(None, ctx)
         kn = self.knots(ctx)
         span = ctx.xrange[1] - ctx.xrange[0]
-        bump = hats @ (np.abs(kn - np.mean(ctx.sig.x)) < 0.1 * span).astype(float)
+        near = (np.abs(kn - np.mean(ctx.sig.x)) < 0.1 * span).astype(float)
+        # the hats kept at the rows the scorer reads only (all its fits read of them),
+        # built a few at a time: whole, they are 200 MB on a million samples
+        step = int(ctx.extra.get("rows_step", 1))
+        hats = np.empty((len(range(0, ctx.sig.x.size, step)), kn.size))
+        bump = np.zeros(ctx.sig.x.size)
+        for js, cols in self._hats(ctx):
+            hats[:, js] = rows_of(cols, step)
+            bump += cols @ near[js]
         ft = Term(cand=None, h=None, X=hats, prior=self.prior_tol(None, ctx))
         b = share(float(sizes([bump], fits=[ft])[0]))
         return hide(self.effect, b, "-", f"a friction change {under(100 * b, '{:.2g} %')} "

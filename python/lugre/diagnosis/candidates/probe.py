@@ -11,8 +11,20 @@ import numpy as np
 from ... import units as U
 from .. import residual as R
 
-__all__ = ["amps", "hide", "rate_noise_power", "refit_on", "reversals", "share", "start_of",
-           "two_ways", "under"]
+__all__ = ["AT_ONCE", "amps", "hide", "in_batches", "rate_noise_power", "refit_on",
+           "reversals", "share", "start_of", "two_ways", "under"]
+
+
+#: Columns of a limit built and judged at once: each is 8 MB a million samples, and its
+#: size is its own (the same numbers in any grouping).
+AT_ONCE = 4
+
+
+def in_batches(judge: Any, pts: list[Any], at_once: int = AT_ONCE) -> np.ndarray:
+    """``judge(pts)`` (one size per point, from columns it builds) a few points at a
+    time, so that only a few whole columns live at once."""
+    out = [np.asarray(judge(pts[i:i + at_once]), float) for i in range(0, len(pts), at_once)]
+    return np.concatenate(out) if out else np.array([])
 
 
 def start_of(scorer: Any, terms: list[Any], k: int) -> int:

@@ -8,7 +8,7 @@ import numpy as np
 
 from ...vocabulary import RESONANCE
 from .base import Context, grid_interval, objects
-from .probe import hide
+from .probe import hide, in_batches
 from .secant import _Secant
 
 __all__ = ["Resonance"]
@@ -109,8 +109,8 @@ class Resonance(_Secant):
                         experiment="the filter band is too narrow; record faster")
         fs = sorted({h[0] for h in g})
         pts = [(f, 0.05, 0.5) for f in fs]
-        cols = self.columns_many(pts, ctx) or [self.columns(h, ctx) for h in pts]
-        sz = list(sizes([X[:, 0] for X in cols]))  # in units of the half-mass load's force
+        # (in units of the half-mass load's force)
+        sz = list(in_batches(lambda ps: sizes(self.columns_of(ps, ctx)), pts))
         hidden = [f for f, s in zip(fs, sz) if s > 1.0]
         if not hidden:
             # the load's force grows about in proportion to its share of the mass

@@ -13,7 +13,7 @@ from ...vocabulary import DEADBAND, STRIBECK_SHAPE, is_timing
 from .. import residual as R
 from ..residual import Signals
 from .base import Candidate, Context, by, by_current, grid_interval
-from .probe import amps, hide, refit_on, start_of
+from .probe import AT_ONCE, amps, hide, refit_on, start_of
 
 __all__ = ["Deadband", "StribeckShape", "_Secant"]
 
@@ -52,14 +52,21 @@ class _Secant(Candidate):
         return (self._r_base(ctx) - R.residual(self._with(h, ctx), self._signals(ctx))
                 )[:, None]
 
-    def columns_many(self, hs: list[Any], ctx: Context) -> list[np.ndarray] | None:
+    def columns_many(self, hs: list[Any], ctx: Context, step: int = 1
+                     ) -> list[np.ndarray] | None:
         """The columns of several grid points at once (the kernel runs them in
-        parallel), or None when this candidate builds its columns otherwise."""
+        parallel), or None when this candidate builds its columns otherwise; with
+        ``step``, every ``step``-th row only (:func:`~.base.rows_of`, the same numbers)."""
         if type(self).columns is not _Secant.columns:
             return None
-        r0 = self._r_base(ctx)
+        r0 = self._r_base(ctx)[::step]
         rs = self._signals(ctx).kernel.residuals([self._with(h, ctx) for h in hs])
-        return [(r0 - rs[:, j])[:, None] for j in range(len(hs))]
+        return [(r0 - rs[::step, j])[:, None] for j in range(len(hs))]
+
+    def columns_of(self, hs: list[Any], ctx: Context) -> list[np.ndarray]:
+        """The single columns of grid points ``hs`` (in parallel when the kernel can)."""
+        cols = self.columns_many(hs, ctx) or [self.columns(h, ctx) for h in hs]
+        return [X[:, 0] for X in cols]
 
     def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
         return [self.effect_at(self.from_secant(h, float(beta[0])))]
@@ -140,14 +147,18 @@ class StribeckShape(_Secant):
         """The exponents each side of 2 from which the search would name the shape,
         each judged by the exact change of the residual that it makes (the shape is far
         from linear in the exponent: 2 -> 3 changes the curve less than 2 -> 1)."""
-        pts = list(self.BELOW) + list(self.ABOVE)
-        cols = self.columns_many(pts, ctx) or [self.columns(h, ctx) for h in pts]
-        sz = np.asarray(sizes([X[:, 0] for X in cols]), float)  # 1: the whole change
-        seen = np.isfinite(sz) & (sz <= 1.0)
-        nb = len(self.BELOW)
-        lo = next((h for h, ok in zip(self.BELOW, seen[:nb]) if ok), None)
-        hi = next((h for h, ok in zip(self.ABOVE, seen[nb:]) if ok), None)
-        return lo, hi
+        first: list[float | None] = [None, None]
+        left = [list(self.BELOW), list(self.ABOVE)]
+        # outwards from 2 a few exponents each side at a time, until each side has the
+        # first it would name (the later ones are not read)
+        while any(left):
+            batch = [(s, h) for s in (0, 1) for h in left[s][:AT_ONCE // 2]]
+            left = [rest[AT_ONCE // 2:] for rest in left]
+            sz = np.asarray(sizes(self.columns_of([h for _, h in batch], ctx)), float)
+            for (s, h), size in zip(batch, sz):  # (1: the whole change)
+                if first[s] is None and np.isfinite(size) and size <= 1.0:
+                    first[s], left[s] = h, []
+        return first[0], first[1]
 
     figure = by("v", "velocity [m/s]")
 
