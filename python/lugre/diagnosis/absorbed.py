@@ -73,15 +73,19 @@ def _with(model: Model, effect: str, size: float) -> Model:
 
 
 class _Polisher:
-    """The base polished with an effect held (or none): its residual's rms [N]."""
+    """The base polished with an effect held (or none): its residual's rms [N], the
+    polished model and its residual (an infinite rms where the kernel refuses it)."""
 
     def __init__(self, sig: R.Signals, free_mass: bool) -> None:
         self.sig, self.names = sig, base_names(free_mass)
 
     def __call__(self, model: Model, max_iter: int = POLISH_ITER
                  ) -> tuple[float, Model, np.ndarray]:
-        best, _ = _run(self.sig, [model], self.names, keep=1, max_iter=max_iter)
-        r = np.asarray(self.sig.kernel.residual(best))
+        try:
+            best, _ = _run(self.sig, [model], self.names, keep=1, max_iter=max_iter)
+            r = np.asarray(self.sig.kernel.residual(best))
+        except (ValueError, ArithmeticError):  # (a size the kernel refuses: no candidate)
+            return math.inf, model, np.full(len(self.sig), np.inf)
         used = r[self.sig.mask]
         rms = float(np.sqrt(np.mean(used * used)))
         return (rms if math.isfinite(rms) else math.inf), best, r
@@ -160,6 +164,8 @@ def absorbed_effect(rec: Any, given: Model, augmented: Model, effects: list[str]
     sig = R.prepare(rec, augmented, cutoff_hz=cutoff_hz, backend=backend)
     polish = _Polisher(sig, free_mass)
     rms0, _, r0 = polish(augmented)
+    if not math.isfinite(rms0):
+        return None
     held = {kind(e["effect"]) for e in augmented.effects}
     tried = [_Sizes(e, augmented, polish) for e in effects if e in ABSORBING and e not in held]
     if not tried:
