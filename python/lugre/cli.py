@@ -475,6 +475,14 @@ def _print_fit(fit: Any, effects: list[str]) -> None:
               "the base and is left out of the model: lugre diagnose names it with its "
               "evidence and its augmented model holds it (lugre fit --effects gravity "
               "keeps it in)")
+    for e in fit.model.effects:
+        if e["effect"] == "spring" and "spring" not in effects:
+            print(f"note: the model holds a spring, a {U.force_words()} growing with the "
+                  f"position ({U.fmt(e['stiffness'], U.unit_of('spring', 'stiffness'), 4)} "
+                  f"about {U.fmt(e['x0'], U.unit_of('spring', 'x0'), 4)}): without it the "
+                  "mass came out negative. Its rest position is where the record's "
+                  "standstills put it (while the axis moves, a preload and a difference "
+                  "of the directions' Coulomb levels look alike)")
 
 
 def _cmd_paper(args: argparse.Namespace) -> int:

@@ -16,8 +16,10 @@ import numpy as np
 
 from .. import units as U
 from ..model import Model
+from ..vocabulary import SPRING
 from . import residual as R
 from .base import apply_base, get_base
+from .golden import golden
 
 __all__ = ["BaseFitResult", "base_names", "fit_base", "identify", "profile_all", "starts",
            "with_profiles"]
@@ -436,6 +438,8 @@ def _identify(rec: Any, mass: float | None, force_constant: float, cutoff_hz: fl
     start = fit_inverse_dynamics(rec, sliding=SLIDING, **kw)
     sig = R.prepare(rec, start, cutoff_hz=cutoff_hz, backend=backend)
     res = fit_base(sig, start, free_mass=mass is None, profiles=False)
+    if any(e["effect"] == SPRING for e in res.model.effects):
+        res = fit_base(sig, _spring_rest(sig, res), free_mass=mass is None, profiles=False)
     # the band depends on the mass (the position's noise twice differentiated times
     # the mass against the force's noise): a start far off in mass reads the record in
     # the wrong band, and the fit follows the acceleration's noise; read it again in
@@ -449,6 +453,51 @@ def _identify(rec: Any, mass: float | None, force_constant: float, cutoff_hz: fl
     shift = sampling_shift(rec, res, cutoff_hz=cutoff_hz, backend=backend,
                            free_mass=mass is None)
     return with_profiles(sig, res, shift)
+
+
+#: Golden-section steps that place a spring's rest position.
+REST_STEPS = 10
+
+
+def _spring_rest(sig: R.Signals, res: BaseFitResult) -> Model:
+    """The fit's model with its spring's rest position and stiffness where the record
+    puts them.
+
+    The linear start cannot place the rest position: while the axis moves, a preload
+    beyond the stroke's middle and a difference of the directions' Coulomb levels look
+    alike. At standstill they do not (the bristles hold what the spring pushes with),
+    so the rest position is searched over the stroke (and the start's rest position)
+    and half of it beyond either end, then the stiffness within a factor of 1.5 of the
+    start's (where the mass is little excited the start shares it with the mass), the
+    base polished at each (golden section on the residual's rms)."""
+    names = list(res.names)
+    effects = list(res.model.effects)
+    k = next(k for k, e in enumerate(effects) if e["effect"] == SPRING)
+    spring, others = dict(effects[k]), effects[:k] + effects[k + 1:]
+    x = sig.x[sig.mask]
+    x0 = float(spring["x0"])
+    lo, hi = min(float(np.min(x)), x0), max(float(np.max(x)), x0)
+    span = max(hi - lo, 1e-9)
+
+    def placed(**kw: float) -> Model:
+        return res.model.replace(effects=others + [{**spring, **kw}])
+
+    def rms(model: Model) -> float:
+        try:
+            best, _ = _run(sig, [model], names, keep=1, max_iter=12)
+            r = np.asarray(sig.kernel.residual(best))[sig.mask]
+        except (ValueError, ArithmeticError):  # (a start the kernel refuses)
+            return math.inf
+        v = float(np.sqrt(np.mean(r * r)))
+        return v if math.isfinite(v) else math.inf
+
+    spring["x0"] = golden(lambda u: rms(placed(x0=u)), lo - 0.5 * span, hi + 0.5 * span,
+                          REST_STEPS)
+    k0 = math.log(float(spring["stiffness"]))
+    spring["stiffness"] = math.exp(golden(lambda u: rms(placed(stiffness=math.exp(u))),
+                                          k0 - math.log(1.5), k0 + math.log(1.5),
+                                          REST_STEPS - 2))
+    return placed()
 
 
 def sampling_shift(rec: Any, res: BaseFitResult, *, cutoff_hz: float | None, backend: Any,

@@ -9,7 +9,7 @@ from typing import Any
 
 from ..exceptions import InputError
 from ..model import Model
-from ..vocabulary import GRAVITY, NAMES, kind
+from ..vocabulary import GRAVITY, NAMES, SPRING, kind
 from . import residual as R
 from .basefit import fit_base, identify
 from .core import diagnose
@@ -77,11 +77,13 @@ def fit_model(
     rec = as_recording(recording)
     res = identify(rec, mass=mass, force_constant=force_constant, cutoff_hz=cutoff_hz,
                    backend=backend)
-    if GRAVITY in wanted:  # (the fit holds it already when the record shows one)
-        held = any(e["effect"] == GRAVITY for e in res.model.effects)
-        wanted = [e for e in wanted if e != GRAVITY or not held]
-    else:
-        res = _gravity_set_aside(res)
+    # (the fit holds a joint's weight or a spring already when the record needs one:
+    # the weight is set aside for the diagnosis to name, unless asked for; a spring is
+    # kept, as the base cannot be had without it, and the diagnosis cannot take it
+    # back out of a base refitted without it)
+    held = {e["effect"] for e in res.model.effects} & set(LOADS)
+    res = _set_aside(res, held - set(wanted) - {SPRING})
+    wanted = [e for e in wanted if e not in held]
     if not wanted:
         return _identified(rec, res.model, res, cutoff_hz, backend), res
     dg = diagnose(rec, res.model, candidates=wanted, free_mass=mass is None,
@@ -115,12 +117,17 @@ def _identified(rec: Any, model: Model, fit: Any, cutoff_hz: float | None,
     return model.replace(identification={**ident, "record": as_recording(rec).fingerprint()})
 
 
-def _gravity_set_aside(res: Any) -> Any:
-    """The fit without the gravity its linear start took up beside the base (a joint's
-    load, which friction levels and the mass would otherwise absorb), unless asked for:
-    ``lugre diagnose`` names it with its evidence and the augmented model holds it."""
-    grav = [e for e in res.model.effects if e["effect"] == GRAVITY]
-    if not grav:
+#: Loads the fit's linear start takes up beside the base when the record needs them.
+LOADS = (GRAVITY, SPRING)
+
+
+def _set_aside(res: Any, effects: set[str]) -> Any:
+    """The fit without the ``effects`` its linear start took up beside the base (a
+    joint's weight, a spring, which the friction levels and the mass would otherwise
+    absorb), unless asked for: ``lugre diagnose`` names them with their evidence and
+    the augmented model holds them."""
+    out = [e for e in res.model.effects if e["effect"] in effects]
+    if not out:
         return res
-    rest = [e for e in res.model.effects if e["effect"] != GRAVITY]
-    return replace(res, model=res.model.replace(effects=rest), set_aside=tuple(grav))
+    rest = [e for e in res.model.effects if e["effect"] not in effects]
+    return replace(res, model=res.model.replace(effects=rest), set_aside=tuple(out))

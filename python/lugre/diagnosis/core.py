@@ -14,7 +14,7 @@ from .. import units as U
 from ..exceptions import PassivityWarning
 from ..io import Recording
 from ..model import Model, _as_model
-from ..vocabulary import ONE_OF_A_KIND, kind
+from ..vocabulary import CURRENT_LAG, DELAY, ONE_OF_A_KIND, RESONANCE, kind
 from . import evidence as V
 from . import residual as R
 from .absorbed import ABSORBING, absorbed_effect
@@ -176,20 +176,38 @@ def _absorbed(rec: Recording, model: Model, first: Diagnosis, opts: Options) -> 
     """A fitted base that bent itself to mimic an effect: those the base can mimic whose
     trials gained without being named, sized with the base fitted beside them; the
     search run again from the base beside the best, and kept when it names the effect."""
-    named = {kind(f.effect) for f in first.findings}
-    tried = [t["effect"] for t in first.trials or []
-             if t.get("effect") in ABSORBING and t["effect"] not in named
-             and float(t.get("gain") or 0.0) > opts.min_gain]
-    if not tried:
-        return first
-    far = absorbed_effect(rec, model, first.augmented, list(dict.fromkeys(tried)),
+    far = absorbed_effect(rec, model, first.augmented, _absorbed_starts(first, opts),
                           cutoff_hz=opts.cutoff_hz, backend=opts.backend,
                           free_mass=opts.free_mass, blocks=opts.blocks, alpha=opts.alpha,
                           min_gain=opts.min_gain)
     if far is None:
         return first
     dg = _from_refitted_base(rec, model, first, far, opts)
-    return dg if far["effect"] in {kind(f.effect) for f in dg.findings} else first
+    return dg if kind(far["effect"]) in {kind(f.effect) for f in dg.findings} else first
+
+
+def _absorbed_starts(first: Diagnosis, opts: Options) -> list[dict[str, Any]]:
+    """The effects a fitted base may have mimicked: those of :data:`ABSORBING` whose
+    trials gained without being named (the timing trial stands for both forms; a
+    resonance starts from the point of its best trial)."""
+    named = {kind(f.effect) for f in first.findings}
+    starts: dict[str, dict[str, Any]] = {}
+    for t in sorted(first.trials or [], key=lambda t: -float(t.get("gain") or 0.0)):
+        e = t.get("effect")
+        if (e not in ABSORBING or kind(e) in named or e in starts
+                or not float(t.get("gain") or 0.0) > opts.min_gain):
+            continue
+        if e == RESONANCE:
+            h = t.get("h")
+            if h is None or len(h) != 3:
+                continue
+            starts[e] = {"effect": e, "frequency": float(h[0]),
+                         "damping_ratio": float(h[1]), "load_fraction": float(h[2])}
+        else:
+            starts[e] = {"effect": e}
+        if e == DELAY:
+            starts[CURRENT_LAG] = {"effect": CURRENT_LAG}
+    return list(starts.values())
 
 
 def _run(rec: Recording, model: Model, opts: Options) -> Diagnosis:
