@@ -20,6 +20,7 @@ from lugre.diagnosis import diagnose, fit_model
 from lugre.diagnosis.absorbed import ABSORBING
 from lugre.diagnosis.synth import case
 from lugre.io import Recording
+from lugre.vocabulary import kind
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benches"))
 import calibration_cases as C
@@ -61,6 +62,37 @@ def test_an_effect_the_fit_took_in_is_named_against_that_fit(name):
     rec, hold, believed, _ = case([effect], **setup)
     dg = _chain(rec, believed.force_constant, believed.controller, hold)
     _named(dg, effect, 0.05)
+    before, after = dg.fit["holdout_before"]["rms_force"], dg.fit["holdout_after"]["rms_force"]
+    assert after < 0.5 * before, dg.fit
+
+
+#: (setup of the stress case, the effect, the relative tolerance of its parameter):
+#: stress seed 16, cases 038 (a current lag, 30 s) and 030 (a coupling, cut to 10 s),
+#: both unnamed against their fits before
+SIZED = {
+    "current_lag": ({"seed": 36076, "axis_seed": None, "kind": "p2p", "duration": 30.0,
+                     "rate_hz": 2000.0, "current_noise": 0.012823425748502051,
+                     "quantum": 1e-07, "base_error": 0.013917539087418784},
+                    {"effect": "current_lag", "bandwidth": 118.76543260017726}, 0.1),
+    "resonance": ({"seed": 36060, "axis_seed": None, "kind": "p2p", "duration": 10.0,
+                   "rate_hz": 5000.0, "current_noise": 0.013142035907952262,
+                   "quantum": 1e-06, "base_error": 0.017267598909539893},
+                  {"effect": "resonance", "frequency": 19.125373748485444,
+                   "damping_ratio": 0.03765913612181255,
+                   "load_fraction": 0.7749611735599393}, 0.25),
+}
+
+
+@pytest.mark.parametrize("name", sorted(SIZED))
+def test_a_timing_or_coupling_the_fit_took_in_is_named_against_that_fit(name):
+    setup, effect, tol = SIZED[name]
+    rec, hold, believed, _ = case([effect], **setup)
+    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    key = ABSORBING[effect["effect"]]
+    got = {kind(f.effect): f.parameters for f in dg.findings}
+    assert list(got) == [kind(effect["effect"])], dg.summary()
+    assert got[kind(effect["effect"])][key] == pytest.approx(effect[key], rel=tol), got
+    assert dg.rebased and effect["effect"] in dg.rebased["text"], dg.rebased
     before, after = dg.fit["holdout_before"]["rms_force"], dg.fit["holdout_after"]["rms_force"]
     assert after < 0.5 * before, dg.fit
 

@@ -36,6 +36,12 @@ def split(beta: np.ndarray, q: int, terms: list[Term]) -> tuple[np.ndarray, list
     return np.array(beta[:q], dtype=float), out
 
 
+#: Least share of the given mass a step may leave (a linearised step of a fitted
+#: base beside a resonance went through zero, and the clamped mass of 1 mg made every
+#: simulation of the coupling take seconds).
+MASS_FLOOR = 0.1
+
+
 def refine(model: Model, sig: R.Signals, terms: list[Term], base: dict[str, float],
            betas: list[np.ndarray], s2: float, names: tuple[str, ...] | list[str],
            iters: int = 3, tolerance: float = 1.0
@@ -109,6 +115,8 @@ def refine(model: Model, sig: R.Signals, terms: list[Term], base: dict[str, floa
     # that is better (a step far outside the linear range can make things worse)
     def valid(base: dict[str, float], betas: list[np.ndarray], terms: list[Term]
               ) -> tuple[Any, ...] | None:
+        if not base.get("mass", 1.0) > MASS_FLOOR * theta0.get("mass", 0.0):
+            return None  # (a step through the mass's zero: no axis there)
         try:
             return build(base, betas, terms)
         except ValueError:  # a coefficient outside the effect's range: no model there
