@@ -238,8 +238,11 @@ def simplest(sig: R.Signals, res: BaseFitResult) -> BaseFitResult:
     s1 = prof.get("sigma1")
     if s1 and not s1["determined"]:
         bound = _passive_sigma1(apply_base(res.model, vals))
-        if get_base(res.model, "sigma1") > bound:
-            vals["sigma1"] = 0.5 * bound
+        lo, hi = s1.get("ci95") or [None, None]
+        if get_base(res.model, "sigma1") > bound and (lo is None or lo <= bound):
+            # within the record's interval when it has one (a sigma1 of 955-1458 N s/m
+            # held at half its bound, 524, left the fit at four times the noise floor)
+            vals["sigma1"] = 0.5 * bound if hi is None else max(lo or 0.0, bound)
             held.append("sigma1")
     if not vals:
         return res
@@ -419,7 +422,7 @@ def _passive(res: BaseFitResult) -> BaseFitResult:
     prof = dict(res.profiles)
     p = dict(prof.get("sigma1") or {"ci95": [None, None]})
     lo = (p.get("ci95") or [None, None])[0]
-    if p.get("determined") and lo is not None and lo > bound:
+    if lo is not None and lo > bound:
         p["passivity_bound"] = bound
         prof["sigma1"] = p
         return replace(res, profiles=prof)
