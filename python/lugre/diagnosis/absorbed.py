@@ -131,20 +131,21 @@ class _Polisher:
 
 class _Sizes:
     """Trial sizes of one effect with the base polished beside each: the residual's rms
-    per size, and the grid's best refined between its neighbours."""
+    per size, and the grid's best refined between its neighbours (each polish kept by
+    its size and its iterations: the screen's are short, the refinement's are not)."""
 
     def __init__(self, start: dict[str, Any], model: Model, polish: _Polisher) -> None:
         self.start, self.effect = start, str(start["effect"])
         self.model, self.polish = model, polish
-        self.seen: dict[float, tuple[float, Model, np.ndarray]] = {}
+        self.seen: dict[tuple[float, int], tuple[float, Model, np.ndarray]] = {}
         self.logs = np.log(_grid(self.effect, polish.sig, model, start))
         self.rms = np.array([self.at(float(u), SCREEN_ITER) for u in self.logs])
 
     def at(self, log_size: float, max_iter: int = POLISH_ITER) -> float:
-        s = float(math.exp(log_size))
-        if s not in self.seen or max_iter > SCREEN_ITER:
-            self.seen[s] = self.polish(_with(self.model, self.start, s), max_iter)
-        return self.seen[s][0]
+        key = (float(math.exp(log_size)), max_iter)
+        if key not in self.seen:
+            self.seen[key] = self.polish(_with(self.model, self.start, key[0]), max_iter)
+        return self.seen[key][0]
 
     @property
     def best_rms(self) -> float:
@@ -154,12 +155,12 @@ class _Sizes:
         """(size, rms, model, residual) of the least rms, refined by golden section."""
         k = int(np.argmin(self.rms))
         lo, hi = self.logs[max(k - 1, 0)], self.logs[min(k + 1, self.logs.size - 1)]
-        self.seen.clear()  # (the screen's polishes are short; the refinement's are not)
         self.at(float(self.logs[k]))
         if hi > lo:
             golden(self.at, float(lo), float(hi), REFINE_STEPS)
-        size = min(self.seen, key=lambda s: self.seen[s][0])
-        return (size, *self.seen[size])
+        full = [key for key in self.seen if key[1] == POLISH_ITER]
+        best = min(full, key=lambda key: self.seen[key][0])
+        return (best[0], *self.seen[best])
 
 
 def _blocks(r0: np.ndarray, r1: np.ndarray, sig: R.Signals, blocks: int) -> np.ndarray:
