@@ -69,9 +69,12 @@ def test_the_fit_command_says_the_model_holds_a_spring(tmp_path, capsys):
            "stiffness": (fr["positive"]["fc"] + fr["negative"]["fc"]) / c["setup"]["stroke"]}
     (r, _), = C.records([(c, [eff])])
     write_recording(Recording(**r), tmp_path / "rec.csv")
-    out = tmp_path / "fitted.json"
+    out, page = tmp_path / "fitted.json", tmp_path / "fit.html"
     code = main(["fit", str(tmp_path / "rec.csv"), "--force-constant",
-                 str(c["truth"]["axis"]["force_constant"]), "--json", str(out)])
+                 str(c["truth"]["axis"]["force_constant"]), "--json", str(out),
+                 "--html", str(page)])
     assert code == 0 and out.exists()
     said = capsys.readouterr().out
     assert "the model holds a spring" in said and "N/m" in said
+    html = page.read_text()
+    assert "<td>spring</td>" in html and "N/m" in html, html[-2000:]

@@ -35,6 +35,11 @@ def _model_rows(doc: dict[str, Any]) -> list[list[str]]:
         for name, val in (fr.get(d) or {}).items():
             rows.append([f"{name} ({'v ≥ 0' if d == 'positive' else 'v < 0'})",
                          escape(U.fmt(val, U.base_unit(name)))])
+    for e in doc.get("effects") or []:  # (a spring the fit needed, those asked for)
+        name = str(e.get("effect"))
+        vals = ", ".join(f"{k} {U.fmt(v, U.unit_of(name, k))}" for k, v in e.items()
+                         if k != "effect" and isinstance(v, (int, float)))
+        rows.append([escape(name), escape(vals)])
     return rows
 
 
