@@ -151,6 +151,17 @@ class _Sizes:
     def best_rms(self) -> float:
         return float(self.rms.min()) if self.rms.size else math.inf
 
+    @property
+    def at_edge(self) -> bool:
+        """Whether the grid's best is its largest or smallest size: a size it does not
+        bracket (a clean 500 Hz record's "current lag" went to the grid's 10 Hz). Not
+        for a resonance, whose grid is a neighbourhood of its trial's point (the second
+        search profiles it afresh)."""
+        if self.effect == RESONANCE:
+            return False
+        k = int(np.argmin(self.rms)) if self.rms.size else 0
+        return k in (0, self.rms.size - 1)
+
     def refined(self) -> tuple[float, float, Model, np.ndarray]:
         """(size, rms, model, residual) of the least rms, refined by golden section."""
         k = int(np.argmin(self.rms))
@@ -198,8 +209,8 @@ def absorbed_effect(rec: Any, given: Model, augmented: Model, effects: list[dict
     # the grids screen the effects; only the best is refined and tested, when its
     # screen took half of the fifth already
     top = min(tried, key=lambda z: z.best_rms)
-    if top.best_rms > (1.0 - 0.5 * REBASE_GAIN) * rms0:
-        return None
+    if top.best_rms > (1.0 - 0.5 * REBASE_GAIN) * rms0 or top.at_edge:
+        return None  # (too little, or a size the grid does not bracket)
     size, rms1, fitted, r1 = top.refined()
     ev = block_evidence(_blocks(r0, r1, sig, blocks))
     ok, _ = accept(ev, alpha=alpha, min_gain=min_gain)
