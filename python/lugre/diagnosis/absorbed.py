@@ -41,7 +41,7 @@ from ..vocabulary import (
 )
 from . import residual as R
 from .base import BASE_PARAMS, apply_base, get_base
-from .basefit import _run, base_names
+from .basefit import Polisher, base_names
 from .golden import golden
 from .rebase import REBASE_GAIN, _moves
 from .scoring import accept, block_evidence
@@ -106,27 +106,8 @@ def _with(model: Model, effect: dict[str, Any], size: float) -> Model:
 MASS_FACTOR = 2.0
 
 
-class _Polisher:
-    """The base polished with an effect held (or none): its residual's rms [N], the
-    polished model and its residual (an infinite rms where the kernel refuses it or
-    the mass moved beyond :data:`MASS_FACTOR`)."""
-
-    def __init__(self, sig: R.Signals, free_mass: bool) -> None:
-        self.sig, self.names = sig, base_names(free_mass)
-
-    def __call__(self, model: Model, max_iter: int = POLISH_ITER
-                 ) -> tuple[float, Model, np.ndarray]:
-        refused = math.inf, model, np.full(len(self.sig), np.inf)
-        try:
-            best, _ = _run(self.sig, [model], self.names, keep=1, max_iter=max_iter)
-            if not 1.0 / MASS_FACTOR < best.mass / model.mass < MASS_FACTOR:
-                return refused
-            r = np.asarray(self.sig.kernel.residual(best))
-        except (ValueError, ArithmeticError):  # (a size the kernel refuses: no candidate)
-            return refused
-        used = r[self.sig.mask]
-        rms = float(np.sqrt(np.mean(used * used)))
-        return (rms if math.isfinite(rms) else math.inf), best, r
+def _polisher(sig: R.Signals, free_mass: bool) -> Polisher:
+    return Polisher(sig, base_names(free_mass), MASS_FACTOR)
 
 
 class _Sizes:
@@ -134,7 +115,7 @@ class _Sizes:
     per size, and the grid's best refined between its neighbours (each polish kept by
     its size and its iterations: the screen's are short, the refinement's are not)."""
 
-    def __init__(self, start: dict[str, Any], model: Model, polish: _Polisher) -> None:
+    def __init__(self, start: dict[str, Any], model: Model, polish: Polisher) -> None:
         self.start, self.effect = start, str(start["effect"])
         self.model, self.polish = model, polish
         self.seen: dict[tuple[float, int], tuple[float, Model, np.ndarray]] = {}
@@ -197,8 +178,8 @@ def absorbed_effect(rec: Any, given: Model, augmented: Model, effects: list[dict
     ``size`` and ``evidence`` (the block test against the base polished without it).
     """
     sig = R.prepare(rec, augmented, cutoff_hz=cutoff_hz, backend=backend)
-    polish = _Polisher(sig, free_mass)
-    rms0, _, r0 = polish(augmented)
+    polish = _polisher(sig, free_mass)
+    rms0, _, r0 = polish(augmented, POLISH_ITER)
     if not math.isfinite(rms0):
         return None
     held = {kind(e["effect"]) for e in augmented.effects}

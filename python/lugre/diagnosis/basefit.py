@@ -152,6 +152,31 @@ def _run(sig: R.Signals, start: list[Model], names: list[str], keep: int = 3,
     return apply_base(start[out["start"]], out["values"]), out
 
 
+class Polisher:
+    """The base polished from a model (its other effects held): its residual's rms
+    [N], the polished model and its residual. The rms is infinite where the kernel
+    refuses the model, or where the polish moved the mass beyond ``mass_factor``
+    either way (a base that sheds its mass to make room for an effect is no axis)."""
+
+    def __init__(self, sig: R.Signals, names: list[str],
+                 mass_factor: float | None = None) -> None:
+        self.sig, self.names, self.mass_factor = sig, names, mass_factor
+
+    def __call__(self, model: Model, max_iter: int) -> tuple[float, Model, np.ndarray]:
+        refused = math.inf, model, np.full(len(self.sig), np.inf)
+        try:
+            best, _ = _run(self.sig, [model], self.names, keep=1, max_iter=max_iter)
+            f = self.mass_factor
+            if f is not None and not 1.0 / f < best.mass / model.mass < f:
+                return refused
+            r = np.asarray(self.sig.kernel.residual(best))
+        except (ValueError, ArithmeticError):  # (a model the kernel refuses)
+            return refused
+        used = r[self.sig.mask]
+        rms = float(np.sqrt(np.mean(used * used)))
+        return (rms if math.isfinite(rms) else math.inf), best, r
+
+
 def _value(model: Model, name: str) -> float:
     if name.endswith(".hump"):
         d = name.split(".")[0]
@@ -458,8 +483,10 @@ def _identify(rec: Any, mass: float | None, force_constant: float, cutoff_hz: fl
     return with_profiles(sig, res, shift)
 
 
-#: Golden-section steps that place a spring's rest position.
+#: Golden-section steps that place a spring's rest position, and the iterations of the
+#: base's polish at each.
 REST_STEPS = 10
+REST_ITER = 12
 
 
 def _spring_rest(sig: R.Signals, res: BaseFitResult) -> Model:
@@ -473,7 +500,6 @@ def _spring_rest(sig: R.Signals, res: BaseFitResult) -> Model:
     and half of it beyond either end, then the stiffness within a factor of 1.5 of the
     start's (where the mass is little excited the start shares it with the mass), the
     base polished at each (golden section on the residual's rms)."""
-    names = list(res.names)
     effects = list(res.model.effects)
     k = next(k for k, e in enumerate(effects) if e["effect"] == SPRING)
     spring, others = dict(effects[k]), effects[:k] + effects[k + 1:]
@@ -485,14 +511,10 @@ def _spring_rest(sig: R.Signals, res: BaseFitResult) -> Model:
     def placed(**kw: float) -> Model:
         return res.model.replace(effects=others + [{**spring, **kw}])
 
+    polish = Polisher(sig, list(res.names))
+
     def rms(model: Model) -> float:
-        try:
-            best, _ = _run(sig, [model], names, keep=1, max_iter=12)
-            r = np.asarray(sig.kernel.residual(best))[sig.mask]
-        except (ValueError, ArithmeticError):  # (a start the kernel refuses)
-            return math.inf
-        v = float(np.sqrt(np.mean(r * r)))
-        return v if math.isfinite(v) else math.inf
+        return polish(model, REST_ITER)[0]
 
     spring["x0"] = golden(lambda u: rms(placed(x0=u)), lo - 0.5 * span, hi + 0.5 * span,
                           REST_STEPS)
