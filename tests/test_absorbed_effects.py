@@ -6,7 +6,9 @@ Before, the stress seed 15 cases 027 (a dead-band of 62 mA: the fit raised fc an
 and tripled sigma1) and 028 (a quadratic drag: the fit gave a backward Coulomb level of
 0 and a Stribeck speed eight times the axis's) ended "unexplained"; against the near-true
 model both were named. The record of the independent plant (benches/calibration_cases.py)
-was drawn for this test: its dead-band went unnamed the same way.
+was drawn for this test: its dead-band went unnamed the same way. Since session 18
+``lugre fit`` fits a drag beside the base (``tests/test_fit_drag.py``), and the drag of
+028 is named without the stage.
 """
 
 from __future__ import annotations
@@ -48,12 +50,13 @@ def _chain(rec: Recording, force_constant: float, controller: dict | None,
         return diagnose(rec, fitted, holdout=hold)
 
 
-def _named(dg: object, effect: dict, tol: float) -> None:
+def _named(dg: object, effect: dict, tol: float, rebased: bool = True) -> None:
     name, key = effect["effect"], ABSORBING[effect["effect"]]
     got = {f.effect: f.parameters for f in dg.findings}
     assert list(got) == [name], dg.summary()
     assert got[name][key] == pytest.approx(effect[key], rel=tol), got
-    assert dg.rebased and name in dg.rebased["text"], dg.rebased
+    if rebased:
+        assert dg.rebased and name in dg.rebased["text"], dg.rebased
 
 
 @pytest.mark.parametrize("name", sorted(STRESS))
@@ -61,7 +64,9 @@ def test_an_effect_the_fit_took_in_is_named_against_that_fit(name):
     setup, effect = STRESS[name]
     rec, hold, believed, _ = case([effect], **setup)
     dg = _chain(rec, believed.force_constant, believed.controller, hold)
-    _named(dg, effect, 0.05)
+    # (since session 18 the fit sets a drag aside itself: the diagnosis names it from
+    # a sound base, without the stage)
+    _named(dg, effect, 0.05, rebased=name != "drag")
     before, after = dg.fit["holdout_before"]["rms_force"], dg.fit["holdout_after"]["rms_force"]
     assert after < 0.5 * before, dg.fit
 

@@ -470,11 +470,9 @@ def _print_fit(fit: Any, effects: list[str]) -> None:
     from . import units as U
 
     for e in fit.set_aside:
-        print(f"note: a {U.force_words()} following the angle, {e['torque']:.4g} "
-              f"{U.si('N')} at a phase of {e['phase']:.3g} rad (gravity), was fitted beside "
-              "the base and is left out of the model: lugre diagnose names it with its "
-              "evidence and its augmented model holds it (lugre fit --effects gravity "
-              "keeps it in)")
+        print(f"note: {_set_aside_words(e)}, was fitted beside the base and is left out "
+              "of the model: lugre diagnose names it with its evidence and its augmented "
+              f"model holds it (lugre fit --effects {e['effect']} keeps it in)")
     for e in fit.model.effects:
         if e["effect"] == "spring" and "spring" not in effects:
             print(f"note: the model holds a spring, a {U.force_words()} growing with the "
@@ -483,6 +481,17 @@ def _print_fit(fit: Any, effects: list[str]) -> None:
                   "mass came out negative. Its rest position is where the record's "
                   "standstills put it (while the axis moves, a preload and a difference "
                   "of the directions' Coulomb levels look alike)")
+
+
+def _set_aside_words(e: dict[str, Any]) -> str:
+    """What a load the fit set aside is, in words and the axis's units."""
+    from . import units as U
+
+    if e["effect"] == "drag":
+        c = U.fmt(e["coefficient"], U.unit_of("drag", "coefficient"), 4)
+        return (f"a {U.force_words()} growing with the square of the speed, {c} (drag)")
+    return (f"a {U.force_words()} following the angle, {e['torque']:.4g} {U.si('N')} at "
+            f"a phase of {e['phase']:.3g} rad (gravity)")
 
 
 def _cmd_paper(args: argparse.Namespace) -> int:

@@ -9,7 +9,7 @@ from typing import Any
 
 from ..exceptions import InputError
 from ..model import Model
-from ..vocabulary import GRAVITY, NAMES, SPRING, kind
+from ..vocabulary import DRAG, GRAVITY, NAMES, SPRING, kind
 from . import residual as R
 from .basefit import fit_base, identify
 from .core import diagnose
@@ -77,10 +77,10 @@ def fit_model(
     rec = as_recording(recording)
     res = identify(rec, mass=mass, force_constant=force_constant, cutoff_hz=cutoff_hz,
                    backend=backend)
-    # (the fit holds a joint's weight or a spring already when the record needs one:
-    # the weight is set aside for the diagnosis to name, unless asked for; a spring is
-    # kept, as the base cannot be had without it, and the diagnosis cannot take it
-    # back out of a base refitted without it)
+    # (the fit holds a joint's weight, a spring or a drag already when the record
+    # needs one: the weight and the drag are set aside for the diagnosis to name,
+    # unless asked for; a spring is kept, as the base cannot be had without it, and
+    # the diagnosis cannot take it back out of a base refitted without it)
     held = {e["effect"] for e in res.model.effects} & set(LOADS)
     res = _set_aside(res, held - set(wanted) - {SPRING})
     wanted = [e for e in wanted if e not in held]
@@ -118,12 +118,12 @@ def _identified(rec: Any, model: Model, fit: Any, cutoff_hz: float | None,
 
 
 #: Loads the fit's linear start takes up beside the base when the record needs them.
-LOADS = (GRAVITY, SPRING)
+LOADS = (GRAVITY, SPRING, DRAG)
 
 
 def _set_aside(res: Any, effects: set[str]) -> Any:
     """The fit without the ``effects`` its linear start took up beside the base (a
-    joint's weight, a spring, which the friction levels and the mass would otherwise
+    joint's weight, a drag, which the friction levels and the mass would otherwise
     absorb), unless asked for: ``lugre diagnose`` names them with their evidence and
     the augmented model holds them."""
     out = [e for e in res.model.effects if e["effect"] in effects]
