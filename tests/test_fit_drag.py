@@ -14,6 +14,7 @@ joint's weight is. The records come from the independent plant of
 
 from __future__ import annotations
 
+import json
 import sys
 import warnings
 from pathlib import Path
@@ -84,10 +85,16 @@ def test_the_fit_command_says_the_drag_is_set_aside(tmp_path, capsys):
 
     r, truth, _ = _record(202, drag=True)
     write_recording(Recording(**r), tmp_path / "rec.csv")
-    out = tmp_path / "fitted.json"
+    out, page = tmp_path / "fitted.json", tmp_path / "fit.html"
     code = main(["fit", str(tmp_path / "rec.csv"), "--force-constant",
-                 str(truth["axis"]["force_constant"]), "--json", str(out)])
+                 str(truth["axis"]["force_constant"]), "--json", str(out),
+                 "--html", str(page)])
     assert code == 0 and out.exists()
     said = capsys.readouterr().out
     assert "square of the speed" in said and "N s²/m²" in said
     assert "lugre fit --effects drag keeps it in" in said
+    doc = json.loads(out.read_text())
+    assert not doc.get("effects")
+    assert [e["effect"] for e in doc["identification"]["set_aside"]] == ["drag"]
+    html = page.read_text()
+    assert "Check first." in html and "drag (set aside)" in html and "N s²/m²" in html

@@ -70,9 +70,12 @@ def _identification(fit: BaseFitResult, nrmse: float) -> dict[str, Any]:
         if p.get("passivity_bound") is not None:
             params[name]["passivity_bound"] = float(p["passivity_bound"])
     words, far = fit.floor_words()
-    return {"nrmse_force": float(nrmse), "rms_force": fit.rms, "noise_floor": fit.noise,
-            "floor_ratio": fit.floor_ratio, "far_from_floor": far, "summary": words,
-            "parameters": params}
+    out = {"nrmse_force": float(nrmse), "rms_force": fit.rms, "noise_floor": fit.noise,
+           "floor_ratio": fit.floor_ratio, "far_from_floor": far, "summary": words,
+           "parameters": params}
+    if fit.set_aside:  # (fitted beside the base, left out for the diagnosis to name)
+        out["set_aside"] = [dict(e) for e in fit.set_aside]
+    return out
 
 
 def undetermined_notes(fit: BaseFitResult) -> list[str]:

@@ -36,11 +36,32 @@ def _model_rows(doc: dict[str, Any]) -> list[list[str]]:
             rows.append([f"{name} ({'v ≥ 0' if d == 'positive' else 'v < 0'})",
                          escape(U.fmt(val, U.base_unit(name)))])
     for e in doc.get("effects") or []:  # (a spring the fit needed, those asked for)
-        name = str(e.get("effect"))
-        vals = ", ".join(f"{k} {U.fmt(v, U.unit_of(name, k))}" for k, v in e.items()
-                         if k != "effect" and isinstance(v, (int, float)))
-        rows.append([escape(name), escape(vals)])
+        rows.append([escape(str(e.get("effect"))), escape(_effect_values(e))])
+    for e in _set_aside(doc):
+        rows.append([escape(f"{e.get('effect')} (set aside)"),
+                     escape(_effect_values(e) + ": not in the model; lugre diagnose names it")])
     return rows
+
+
+def _effect_values(e: dict[str, Any]) -> str:
+    name = str(e.get("effect"))
+    return ", ".join(f"{k} {U.fmt(v, U.unit_of(name, k))}" for k, v in e.items()
+                     if k != "effect" and isinstance(v, (int, float)))
+
+
+def _aside_words(aside: list[dict[str, Any]]) -> str:
+    if not aside:
+        return ""
+    names = " and ".join(escape(str(e.get("effect"))) for e in aside)
+    return (f" The fit found a {names} beside the base (the fit's residual is with it) and "
+            "left it out of this model: run lugre diagnose on this record with this model, "
+            "which names it with its evidence; its augmented model holds it.")
+
+
+def _set_aside(doc: dict[str, Any]) -> list[dict[str, Any]]:
+    """Effects the fit found beside the base and left out of the model."""
+    return [e for e in (doc.get("identification") or {}).get("set_aside") or []
+            if isinstance(e, dict)]
 
 
 def _stribeck_uri(doc: dict[str, Any], v: Any = None, F: Any = None,
@@ -139,12 +160,13 @@ def _fit_page(model: dict[str, Any], rec: Any, *, source: str | None,
     body = []
     ident = model.get("identification") or {}
     if ident.get("summary"):
-        far = bool(ident.get("far_from_floor"))
+        aside = _set_aside(model)
+        far = bool(ident.get("far_from_floor")) or bool(aside)
         head = "Check first." if far else "Result."
         body.append(f"<div class=\"verdict{'' if far else ' ok'}\"><b>{head}</b> The identified "
                     f"model explains the motor {U.force_words()} to "
                     f"{100 * float(ident['nrmse_force']):.2f} % rms; "
-                    f"{escape(str(ident['summary']))}.</div>")
+                    f"{escape(str(ident['summary']))}.{_aside_words(aside)}</div>")
     elif nrmse:
         best = min(v for v in nrmse.values() if v is not None)
         body.append("<div class=\"verdict ok\"><b>Result.</b> The identified model "
