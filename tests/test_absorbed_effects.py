@@ -140,3 +140,23 @@ def test_a_clean_rotary_record_against_its_fit_gets_no_lag_from_the_grids_edge()
     dg = _chain(rec, c["truth"]["axis"]["torque_constant"], c["believed"].get("controller"),
                 hold)
     assert not dg.findings and not dg.rebased, dg.summary()
+
+
+def test_a_drag_beside_a_deadband_survives_the_joint_refit():
+    """Stress seed 18, case 047 (unseen when drawn): the fit set the drag aside, the
+    search took it and a current limit, and the current limit's exact form left the
+    joint refit 1.4e8 noise units worse than without it; the backward check then
+    dropped both, and the dead-band was never reached (``joint._without_weak`` now
+    drops one term at a time)."""
+    setup = {"seed": 38094, "axis_seed": 8038, "kind": "p2p", "duration": 10.0,
+             "rate_hz": 5000.0, "current_noise": 0.01889120651249719, "quantum": 1e-07,
+             "base_error": 0.019896702923822288}
+    effects = [{"effect": "drag", "coefficient": 54.00109976350709},
+               {"effect": "deadband", "current": 0.02833876845406429}]
+    rec, hold, believed, _ = case(effects, **setup)
+    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    got = {f.effect: f.parameters for f in dg.findings}
+    assert sorted(got) == ["deadband", "drag"], dg.summary()
+    assert got["drag"]["coefficient"] == pytest.approx(54.0, rel=0.05)
+    assert got["deadband"]["current"] == pytest.approx(0.0283, rel=0.05)
+    assert dg.fit["holdout_after"]["rms_force"] < 0.2 * dg.fit["holdout_before"]["rms_force"]
