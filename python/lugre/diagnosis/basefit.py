@@ -459,18 +459,16 @@ def _passive(res: BaseFitResult) -> BaseFitResult:
 def _identify(rec: Any, mass: float | None, force_constant: float, cutoff_hz: float | None,
               controller: dict[str, Any] | None, backend: Any, profiles: bool
               ) -> BaseFitResult:
-    from .inverse import inverse_start
+    from .inverse import inverse_starts
 
-    kw = {"mass": mass, "force_constant": force_constant, "cutoff_hz": cutoff_hz,
-          "controller": controller, "backend": backend, "sliding": SLIDING}
-    start = inverse_start(rec, **kw)
+    start, other = inverse_starts(
+        rec, mass=mass, force_constant=force_constant, cutoff_hz=cutoff_hz,
+        controller=controller, backend=backend, sliding=SLIDING)
     sig = R.prepare(rec, start, cutoff_hz=cutoff_hz, backend=backend)
     res = _with_sized_loads(sig, start, mass is None)
-    if res.floor_ratio > DRAG_FAR and not any(e["effect"] == DRAG for e in res.model.effects):
-        other = inverse_start(rec, drag=True, **kw)
-        if any(e["effect"] == DRAG for e in other.effects):
-            alt = _with_sized_loads(sig, other, mass is None)
-            res = alt if alt.rms < DRAG_CUT * res.rms else res
+    if res.floor_ratio > DRAG_FAR and other is not None:
+        alt = _with_sized_loads(sig, other, mass is None)
+        res = alt if alt.rms < DRAG_CUT * res.rms else res
     # the band depends on the mass (the position's noise twice differentiated times
     # the mass against the force's noise): a start far off in mass reads the record in
     # the wrong band, and the fit follows the acceleration's noise; read it again in

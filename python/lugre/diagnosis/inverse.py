@@ -15,7 +15,7 @@ from . import residual as R
 from .evaluation import as_recording
 from .options import IDENTIFY_TOLERANCE
 
-__all__ = ["IDENTIFY_TOLERANCE", "fit_inverse_dynamics", "inverse_start"]
+__all__ = ["IDENTIFY_TOLERANCE", "fit_inverse_dynamics", "inverse_start", "inverse_starts"]
 
 
 def fit_inverse_dynamics(
@@ -86,13 +86,27 @@ def inverse_start(recording: Any, *, mass: float | None, force_constant: float,
     """:func:`fit_inverse_dynamics`; with ``drag``, a quadratic drag beside the base
     whenever it is plausible (a positive coefficient, positive levels and mass), for a
     fit to compare against the one without it."""
+    start, other = inverse_starts(
+        recording, mass=mass, force_constant=force_constant, sigma0=sigma0,
+        cutoff_hz=cutoff_hz, controller=controller, backend=backend, sliding=sliding,
+        axis_kind=axis_kind)
+    return other if drag and other is not None else start
+
+
+def inverse_starts(recording: Any, *, mass: float | None, force_constant: float,
+                   sigma0: float | None = None, cutoff_hz: float | None,
+                   controller: dict[str, Any] | None, backend: Any,
+                   sliding: float | None, axis_kind: str | None = None
+                   ) -> tuple[Model, Model | None]:
+    """The linear start (:func:`fit_inverse_dynamics`), and beside it, when the start
+    holds no drag and one is plausible, the start with a quadratic drag (for a fit to
+    compare against): one preparation of the record and one grid of fits for both."""
     rec = as_recording(recording)
     R.check_recording(rec)
     kind = axis_kind or rec.meta.get("axis_kind", "linear")
     proto = Model.paper().replace(
         axis=axis_document(kind, 1.0, force_constant), effects=[], controller=None)
     sig = R.prepare(rec, proto, cutoff_hz=cutoff_hz, backend=backend)
-    v = sig.v
     m = sig.mask
     vmax = float(np.max(np.abs(sig.vf[m])))
     if sliding is not None:
@@ -100,6 +114,7 @@ def inverse_start(recording: Any, *, mass: float | None, force_constant: float,
         m = m & (np.abs(sig.vf) > max(sliding * vmax, 10 * q / sig.dt))
         if min(np.sum(m & (sig.vf > 0)), np.sum(m & (sig.vf < 0))) < 20:
             m = sig.mask
+    v = sig.v
     pos, neg = (v > 0).astype(float), (v < 0).astype(float)
     y = sig.fm_f.copy()
     if mass is not None:
@@ -121,7 +136,17 @@ def inverse_start(recording: Any, *, mass: float | None, force_constant: float,
     # the core's estimate::irls_linear_grid or its NumPy twin
     found = R.kernels(sig.backend).irls_linear_grid(X, extras, y[m])
     off = 0 if mass is not None else 1
-    found, loads = _with_loads(sig, kind, X, extras, y[m], m, found, off, drag)
+    kept, forced = _with_loads(sig, kind, X, extras, y[m], m, found, off)
+    args = (sig, kind, grid, vmax, off, mass, force_constant, sigma0, controller)
+    start = _start(*args, *kept)
+    return start, (_start(*args, *forced) if forced is not None else None)
+
+
+def _start(sig: Any, kind: str, grid: np.ndarray, vmax: float, off: int,
+           mass: float | None, force_constant: float, sigma0: float | None,
+           controller: dict[str, Any] | None, found: Any, loads: list[str]) -> Model:
+    """The model of one linear fit (``found``, with the ``loads``' columns after the
+    base's)."""
     vs = float(grid[found.chosen]) if found.chosen is not None else None
     b = found.fit.coef
     mm = float(mass) if mass is not None else float(b[0])
@@ -187,12 +212,12 @@ LOAD_WIDTH = {GRAVITY: 2, SPRING: 1, DRAG: 1}
 
 
 def _with_loads(sig: Any, kind: str, X: np.ndarray, extras: list[np.ndarray],
-                y: np.ndarray, m: np.ndarray, found: Any, off: int,
-                drag: bool) -> tuple[Any, list[str]]:
+                y: np.ndarray, m: np.ndarray, found: Any, off: int
+                ) -> tuple[tuple[Any, list[str]], tuple[Any, list[str]] | None]:
     """The linear fit with the loads the record needs beside the base (their columns
-    after the base's, in the order of the returned names): a joint's weight or a
-    spring (:func:`_load_columns`), then a quadratic drag (whenever plausible with
-    ``drag``)."""
+    after the base's, in the order of the names): a joint's weight or a spring
+    (:func:`_load_columns`), then a quadratic drag; and beside it, when the drag was
+    not kept but is plausible, the fit with it (None otherwise)."""
     fit = R.kernels(sig.backend).irls_linear_grid
     loads: list[str] = []
     load = _load_columns(sig, kind)
@@ -211,14 +236,14 @@ def _with_loads(sig: Any, kind: str, X: np.ndarray, extras: list[np.ndarray],
         loads.append(GRAVITY if kind == "rotary" else SPRING)
     with_d = fit(np.column_stack([X, sig.filt(sig.v * np.abs(sig.v))[m]]), extras, y)
     b0, b1 = found.fit.coef, with_d.fit.coef
+    plausible = (b1[X.shape[1]] > 0 and b1[off] > 0 and b1[off + 2] > 0
+                 and (not off or b1[0] > 0))
     bent = not (b0[off] > 0 and b0[off + 2] > 0)
-    limit = (math.inf if drag else (1.0 + DRAG_BENT_RISE) if bent
-             else (1.0 - DRAG_GAIN))
-    if (b1[X.shape[1]] > 0 and b1[off] > 0 and b1[off + 2] > 0 and (not off or b1[0] > 0)
-            and with_d.fit.scale < limit * found.fit.scale):
-        found = with_d
-        loads.append(DRAG)
-    return found, loads
+    limit = (1.0 + DRAG_BENT_RISE) if bent else (1.0 - DRAG_GAIN)
+    drag = (with_d, loads + [DRAG])
+    if plausible and with_d.fit.scale < limit * found.fit.scale:
+        return drag, None
+    return (found, loads), (drag if plausible else None)
 
 
 def _plausible(b: np.ndarray, off: int, spring: bool = False) -> bool:
