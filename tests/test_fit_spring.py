@@ -8,17 +8,20 @@ residual 24 times the noise floor).
 Now the linear start tries the position beside the base when the mass is fitted, keeps
 it when it takes a tenth off the robust scale, and the fit places the spring's rest
 position by the standstills and polishes its stiffness (``basefit._spring_rest``).
+The spring is then set aside for ``lugre diagnose`` to name, as a drag or a joint's
+weight is (``lugre fit --effects spring`` keeps it in the model).
 The records come from the independent plant of ``benches/calibration_cases.py``.
 """
 
 from __future__ import annotations
 
+import json
 import sys
 import warnings
 from pathlib import Path
 
 import pytest
-from lugre import write_recording
+from lugre import diagnose, write_recording
 from lugre.diagnosis import fit_model
 from lugre.io import Recording
 
@@ -26,24 +29,29 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benches"))
 import calibration_cases as C
 
 
-def _fit(seed: int, spring: bool) -> tuple[object, object, dict, dict | None]:
+def _record(seed: int, spring: bool) -> tuple[dict, dict, dict | None]:
     c = C.draw_case(seed, max_duration=8.0, family="linear")
     fr = c["truth"]["friction"]
     fc = 0.5 * (fr["positive"]["fc"] + fr["negative"]["fc"])
     eff = ({"effect": "spring", "stiffness": 2.0 * fc / c["setup"]["stroke"], "x0": 0.01}
            if spring else None)
     (r, _), = C.records([(c, [eff] if eff else [])])
+    return r, c["truth"], eff
+
+
+def _fit(seed: int, spring: bool) -> tuple[object, object, dict, dict | None]:
+    r, truth, eff = _record(seed, spring)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        model, fit = fit_model(Recording(**r), force_constant=c["truth"]["axis"]["force_constant"])
-    return model, fit, c["truth"], eff
+        model, fit = fit_model(Recording(**r), force_constant=truth["axis"]["force_constant"])
+    return model, fit, truth, eff
 
 
 @pytest.mark.parametrize("seed", [201, 204])
-def test_a_springs_record_is_fitted_with_the_spring_and_the_right_mass(seed):
+def test_a_springs_record_is_fitted_beside_the_spring_with_the_right_mass(seed):
     model, fit, truth, eff = _fit(seed, spring=True)
-    springs = [e for e in model.effects if e["effect"] == "spring"]
-    assert len(springs) == 1, model.effects
+    springs = [e for e in fit.set_aside if e["effect"] == "spring"]
+    assert len(springs) == 1 and not model.effects, (fit.set_aside, model.effects)
     s = springs[0]
     assert s["stiffness"] == pytest.approx(eff["stiffness"], rel=0.03)
     assert s["x0"] == pytest.approx(eff["x0"], abs=2e-3)
@@ -55,12 +63,23 @@ def test_a_springs_record_is_fitted_with_the_spring_and_the_right_mass(seed):
 
 @pytest.mark.parametrize("seed", [301, 305])
 def test_a_clean_record_is_fitted_without_a_spring(seed):
-    model, _, truth, _ = _fit(seed, spring=False)
-    assert not model.effects
+    model, fit, truth, _ = _fit(seed, spring=False)
+    assert not model.effects and not fit.set_aside
     assert model.mass == pytest.approx(truth["axis"]["mass"], rel=0.02)
 
 
-def test_the_fit_command_says_the_model_holds_a_spring(tmp_path, capsys):
+def test_the_diagnosis_names_the_spring_the_fit_set_aside():
+    r, truth, eff = _record(204, spring=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model, _ = fit_model(Recording(**r), force_constant=truth["axis"]["force_constant"])
+        dg = diagnose(Recording(**r), model)
+    found = {f.effect: f for f in dg.findings}
+    assert set(found) == {"spring"}, dg.verdict
+    assert found["spring"].parameters["stiffness"] == pytest.approx(eff["stiffness"], rel=0.05)
+
+
+def test_the_fit_command_says_the_spring_is_set_aside(tmp_path, capsys):
     from lugre.cli import main
 
     c = C.draw_case(204, max_duration=8.0, family="linear")
@@ -75,6 +94,10 @@ def test_the_fit_command_says_the_model_holds_a_spring(tmp_path, capsys):
                  "--html", str(page)])
     assert code == 0 and out.exists()
     said = capsys.readouterr().out
-    assert "the model holds a spring" in said and "N/m" in said
+    assert "growing with the position" in said and "N/m" in said
+    assert "lugre fit --effects spring keeps it in" in said
+    doc = json.loads(out.read_text())
+    assert not doc.get("effects")
+    assert [e["effect"] for e in doc["identification"]["set_aside"]] == ["spring"]
     html = page.read_text()
-    assert "<td>spring</td>" in html and "N/m" in html, html[-2000:]
+    assert "Check first." in html and "spring (set aside)" in html and "N/m" in html

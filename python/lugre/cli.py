@@ -467,20 +467,10 @@ def _print_fit(fit: Any, effects: list[str]) -> None:
                   "stretches); left out of the model", file=sys.stderr)
     for note in undetermined_notes(fit):
         print(f"note: {note}")
-    from . import units as U
-
     for e in fit.set_aside:
         print(f"note: {_set_aside_words(e)}, was fitted beside the base and is left out "
               "of the model: lugre diagnose names it with its evidence and its augmented "
               f"model holds it (lugre fit --effects {e['effect']} keeps it in)")
-    for e in fit.model.effects:
-        if e["effect"] == "spring" and "spring" not in effects:
-            print(f"note: the model holds a spring, a {U.force_words()} growing with the "
-                  f"position ({U.fmt(e['stiffness'], U.unit_of('spring', 'stiffness'), 4)} "
-                  f"about {U.fmt(e['x0'], U.unit_of('spring', 'x0'), 4)}): without it the "
-                  "mass came out negative. Its rest position is where the record's "
-                  "standstills put it (while the axis moves, a preload and a difference "
-                  "of the directions' Coulomb levels look alike)")
 
 
 def _set_aside_words(e: dict[str, Any]) -> str:
@@ -490,6 +480,13 @@ def _set_aside_words(e: dict[str, Any]) -> str:
     if e["effect"] == "drag":
         c = U.fmt(e["coefficient"], U.unit_of("drag", "coefficient"), 4)
         return (f"a {U.force_words()} growing with the square of the speed, {c} (drag)")
+    if e["effect"] == "spring":
+        k = U.fmt(e["stiffness"], U.unit_of("spring", "stiffness"), 4)
+        x0 = U.fmt(e["x0"], U.unit_of("spring", "x0"), 4)
+        return (f"a {U.force_words()} growing with the position, {k} about {x0} (spring; "
+                "its rest position is where the record's standstills put it: while the "
+                "axis moves, a preload and a difference of the directions' Coulomb "
+                "levels look alike)")
     return (f"a {U.force_words()} following the angle, {e['torque']:.4g} {U.si('N')} at "
             f"a phase of {e['phase']:.3g} rad (gravity)")
 

@@ -78,11 +78,10 @@ def fit_model(
     res = identify(rec, mass=mass, force_constant=force_constant, cutoff_hz=cutoff_hz,
                    backend=backend)
     # (the fit holds a joint's weight, a spring or a drag already when the record
-    # needs one: the weight and the drag are set aside for the diagnosis to name,
-    # unless asked for; a spring is kept, as the base cannot be had without it, and
-    # the diagnosis cannot take it back out of a base refitted without it)
+    # needs one: fitted beside the base, which cannot be had without them, and set
+    # aside for the diagnosis to name, unless asked for)
     held = {e["effect"] for e in res.model.effects} & set(LOADS)
-    res = _set_aside(res, held - set(wanted) - {SPRING})
+    res = _set_aside(res, held - set(wanted))
     wanted = [e for e in wanted if e not in held]
     if not wanted:
         return _identified(rec, res.model, res, cutoff_hz, backend), res

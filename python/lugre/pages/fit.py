@@ -35,7 +35,7 @@ def _model_rows(doc: dict[str, Any]) -> list[list[str]]:
         for name, val in (fr.get(d) or {}).items():
             rows.append([f"{name} ({'v ≥ 0' if d == 'positive' else 'v < 0'})",
                          escape(U.fmt(val, U.base_unit(name)))])
-    for e in doc.get("effects") or []:  # (a spring the fit needed, those asked for)
+    for e in doc.get("effects") or []:  # (those asked for)
         rows.append([escape(str(e.get("effect"))), escape(_effect_values(e))])
     for e in _set_aside(doc):
         rows.append([escape(f"{e.get('effect')} (set aside)"),
