@@ -131,8 +131,8 @@ def diagnose(
         first = dg
         if fitted and candidates is None:
             dg = _absorbed(rec, model, dg, opts)
-        far = None if candidates is not None or dg is not first else far_base(
-            rec, model, dg.augmented, cutoff_hz=cutoff_hz, backend=backend,
+        far = None if candidates is not None or dg is not first else _far(
+            rec, model, dg, bool(fitted), cutoff_hz=cutoff_hz, backend=backend,
             free_mass=free_mass)
         if far is not None:
             dg = _from_refitted_base(rec, model, dg, far, opts)
@@ -156,6 +156,27 @@ def diagnose(
             PassivityWarning, stacklevel=2)
     dg.timing = time.perf_counter() - t_start
     return dg
+
+
+def _far(rec: Recording, model: Model, dg: Diagnosis, fitted: bool,
+         **kw: Any) -> dict[str, Any] | None:
+    """:func:`far_base` with the findings in; for a base that ``lugre fit`` identified,
+    when nothing was named but the rest resembles effects of the vocabulary, with those
+    in: a fitted base bends itself to mimic what the record holds (a spring, a cogging
+    and a friction bump taken into its hump), and leaves most of their joint unexplained
+    until it is refitted with them. (A base given as believed is not refitted on a
+    resemblance: beside physics outside the vocabulary, the levels would bend to it.)"""
+    far = far_base(rec, model, dg.augmented, **kw)
+    rest = dg.unexplained or {}
+    alike = rest.get("resembles") or []
+    if far is not None or dg.findings or not alike or not fitted:
+        return far
+    # (the refit must beat the rest the first pass left, not the resembled terms' joint
+    # on the bent base: outside the vocabulary that joint can be far worse than either)
+    held = [{"effect": r["effect"], **r["parameters"]} for r in alike]
+    return far_base(rec, model, dg.augmented.replace(
+        effects=list(dg.augmented.effects) + held), held="the effects it resembles",
+        rms_before=float(rest["rms_force"]), **kw)
 
 
 def _from_refitted_base(rec: Recording, model: Model, first: Diagnosis, far: dict[str, Any],

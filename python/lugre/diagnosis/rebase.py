@@ -35,20 +35,24 @@ def _rms(r: np.ndarray, mask: np.ndarray) -> float:
 
 
 def far_base(rec: Any, given: Model, augmented: Model, *, cutoff_hz: float | None,
-             backend: Any, free_mass: bool) -> dict[str, Any] | None:
+             backend: Any, free_mass: bool, held: str = "the findings",
+             rms_before: float | None = None) -> dict[str, Any] | None:
     """Whether the given base is far from what the record supports.
 
     Returns None, or ``model`` (the given model, its own effects kept, with the base
     fitted from the grid of starts with the findings held in), ``moves`` (per parameter moved beyond the tolerances:
     ``name``, ``given``, ``refit``, ``change``), ``rms_given`` and ``rms_refit`` [N]
     (the augmented model's residual before and after the quick refit) and ``text``.
+    ``rms_before`` [N], when given, is the residual the refit must beat instead of the
+    augmented model's; ``held`` says in words what the refit held in.
     """
     sig = R.prepare(rec, augmented, cutoff_hz=cutoff_hz, backend=backend)
     names = base_names(free_mass)
     quick, _ = _run(sig, [augmented], names, keep=1, max_iter=30)
-    r0 = np.asarray(sig.kernel.residual(augmented))
     r1 = np.asarray(sig.kernel.residual(quick))
-    rms0, rms1 = _rms(r0, sig.mask), _rms(r1, sig.mask)
+    rms1 = _rms(r1, sig.mask)
+    rms0 = (_rms(np.asarray(sig.kernel.residual(augmented)), sig.mask)
+            if rms_before is None else rms_before)
     if not rms1 < (1.0 - REBASE_GAIN) * rms0:
         return None
     moved = _moves(given, quick, names)
@@ -62,7 +66,7 @@ def far_base(rec: Any, given: Model, augmented: Model, *, cutoff_hz: float | Non
     moves = _moves(given, refit, names) or moved
     text = ("the base as given is far from what this record supports: "
             + ", ".join(_move_words(m) for m in moves)
-            + f"; refitted with the findings in, the {U.force_words()} residual falls from "
+            + f"; refitted with {held} in, the {U.force_words()} residual falls from "
             f"{rms0:.3g} to {rms1:.3g} {U.si('N')} rms. The search was run again from the "
             "refitted base, so "
             "that no finding stands in for a base parameter")
