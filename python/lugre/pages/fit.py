@@ -182,6 +182,10 @@ def _fit_page(model: dict[str, Any], rec: Any, *, source: str | None,
         body.append("<h2>What the record determines</h2>")
         body.append(_table(["parameter", "value", "95 % interval", "determined"],
                            _ident_rows(ident["parameters"]), {1, 2}))
+        body.append("<p>The intervals are the record's noise's: a model error that the "
+                    "noise does not show (physics the model leaves out, a sampling that "
+                    "differs from the model's) is not in them. The further the fit is "
+                    "from the noise floor, the less they hold.</p>")
     body.append("<h2>Identified model</h2>")
     body.append(_table(["parameter", "value"], _model_rows(model), {1}))
     v = None
