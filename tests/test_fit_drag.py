@@ -14,19 +14,19 @@ joint's weight is. The records come from the independent plant of
 
 from __future__ import annotations
 
-import json
 import sys
 import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
-from lugre import diagnose, write_recording
+from lugre import diagnose
 from lugre.diagnosis import fit_model
 from lugre.io import Recording
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benches"))
 import calibration_cases as C
+from set_aside_check import check_fit_command
 
 
 def _record(seed: int, drag: bool) -> tuple[dict, dict, float]:
@@ -81,20 +81,6 @@ def test_the_diagnosis_names_the_drag_the_fit_set_aside():
 
 
 def test_the_fit_command_says_the_drag_is_set_aside(tmp_path, capsys):
-    from lugre.cli import main
-
     r, truth, _ = _record(202, drag=True)
-    write_recording(Recording(**r), tmp_path / "rec.csv")
-    out, page = tmp_path / "fitted.json", tmp_path / "fit.html"
-    code = main(["fit", str(tmp_path / "rec.csv"), "--force-constant",
-                 str(truth["axis"]["force_constant"]), "--json", str(out),
-                 "--html", str(page)])
-    assert code == 0 and out.exists()
-    said = capsys.readouterr().out
-    assert "square of the speed" in said and "N s²/m²" in said
-    assert "lugre fit --effects drag keeps it in" in said
-    doc = json.loads(out.read_text())
-    assert not doc.get("effects")
-    assert [e["effect"] for e in doc["identification"]["set_aside"]] == ["drag"]
-    html = page.read_text()
-    assert "Check first." in html and "drag (set aside)" in html and "N s²/m²" in html
+    check_fit_command(tmp_path, capsys, r, truth["axis"]["force_constant"], "drag",
+                      "square of the speed", "N s²/m²")

@@ -15,18 +15,18 @@ The records come from the independent plant of ``benches/calibration_cases.py``.
 
 from __future__ import annotations
 
-import json
 import sys
 import warnings
 from pathlib import Path
 
 import pytest
-from lugre import diagnose, write_recording
+from lugre import diagnose
 from lugre.diagnosis import fit_model
 from lugre.io import Recording
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benches"))
 import calibration_cases as C
+from set_aside_check import check_fit_command
 
 
 def _record(seed: int, spring: bool) -> tuple[dict, dict, dict | None]:
@@ -80,24 +80,10 @@ def test_the_diagnosis_names_the_spring_the_fit_set_aside():
 
 
 def test_the_fit_command_says_the_spring_is_set_aside(tmp_path, capsys):
-    from lugre.cli import main
-
     c = C.draw_case(204, max_duration=8.0, family="linear")
     fr = c["truth"]["friction"]
     eff = {"effect": "spring", "x0": 0.01,
            "stiffness": (fr["positive"]["fc"] + fr["negative"]["fc"]) / c["setup"]["stroke"]}
     (r, _), = C.records([(c, [eff])])
-    write_recording(Recording(**r), tmp_path / "rec.csv")
-    out, page = tmp_path / "fitted.json", tmp_path / "fit.html"
-    code = main(["fit", str(tmp_path / "rec.csv"), "--force-constant",
-                 str(c["truth"]["axis"]["force_constant"]), "--json", str(out),
-                 "--html", str(page)])
-    assert code == 0 and out.exists()
-    said = capsys.readouterr().out
-    assert "growing with the position" in said and "N/m" in said
-    assert "lugre fit --effects spring keeps it in" in said
-    doc = json.loads(out.read_text())
-    assert not doc.get("effects")
-    assert [e["effect"] for e in doc["identification"]["set_aside"]] == ["spring"]
-    html = page.read_text()
-    assert "Check first." in html and "spring (set aside)" in html and "N/m" in html
+    check_fit_command(tmp_path, capsys, r, c["truth"]["axis"]["force_constant"], "spring",
+                      "growing with the position", "N/m")

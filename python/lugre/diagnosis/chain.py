@@ -122,8 +122,8 @@ LOADS = (GRAVITY, SPRING, DRAG)
 
 def _set_aside(res: Any, effects: set[str]) -> Any:
     """The fit without the ``effects`` its linear start took up beside the base (a
-    joint's weight, a drag, which the friction levels and the mass would otherwise
-    absorb), unless asked for: ``lugre diagnose`` names them with their evidence and
+    joint's weight, a spring, a drag, which the friction levels and the mass would
+    otherwise absorb), unless asked for: ``lugre diagnose`` names them with their evidence and
     the augmented model holds them."""
     out = [e for e in res.model.effects if e["effect"] in effects]
     if not out:

@@ -162,9 +162,10 @@ def _without_weak(rf: _Refitter, j: Joint) -> Joint:
 
 def _weak(rf: _Refitter, j: Joint) -> dict[int, tuple[str, float]]:
     """Backward check: with every term in its exact form, each finding must still add to
-    the refit without it, in most blocks (the reason and what it adds, in noise units) (a damped resonance took up a current lag's
+    the refit without it, in most blocks (a damped resonance took up a current lag's
     attenuation while the selection's timing column was a pure delay; with the lag in
-    its exact form it explained nothing more)."""
+    its exact form it explained nothing more). Per weak term: why, and what it adds
+    [noise units]."""
     terms, betas = j.terms, j.betas
     named_k = [k for k, t in enumerate(terms) if not t.minor and not t.cand.timing]
     if len([t for t in terms if not t.minor]) < 2 or not named_k:
