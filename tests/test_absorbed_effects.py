@@ -73,7 +73,7 @@ def test_an_effect_the_fit_took_in_is_named_against_that_fit(name):
 
 #: (setup of the stress case, the effect, the relative tolerance of its parameter):
 #: stress seed 16, cases 038 (a current lag, 30 s) and 030 (a coupling, cut to 10 s),
-#: both unnamed against their fits before
+#: both unnamed against their fits before, and a coupling whose first trial lay far off
 SIZED = {
     "current_lag": ({"seed": 36076, "axis_seed": None, "kind": "p2p", "duration": 30.0,
                      "rate_hz": 2000.0, "current_noise": 0.012823425748502051,
@@ -85,6 +85,15 @@ SIZED = {
                   {"effect": "resonance", "frequency": 19.125373748485444,
                    "damping_ratio": 0.03765913612181255,
                    "load_fraction": 0.7749611735599393}, 0.25),
+    # stress seed 19, case 030: the first trial against the fit's bent base sat at 64 Hz
+    # with the wrong damping and load share; the stage's neighbourhood of it never
+    # reached the coupling, which went unnamed ("unexplained", 0.80 N held out)
+    "resonance_far_from_its_trial": (
+        {"seed": 39060, "axis_seed": None, "kind": "p2p", "duration": 30.0,
+         "rate_hz": 2000.0, "current_noise": 0.011820679861515524, "quantum": 1e-07,
+         "base_error": 0.019049314729677667},
+        {"effect": "resonance", "frequency": 29.318664249709293,
+         "damping_ratio": 0.06522827794883668, "load_fraction": 0.5462972451479696}, 0.05),
 }
 
 
