@@ -135,7 +135,7 @@ def diagnose(
             rec, model, dg, bool(fitted), cutoff_hz=cutoff_hz, backend=backend,
             free_mass=free_mass)
         if far is not None:
-            dg = _from_refitted_base(rec, model, dg, far, opts)
+            dg = _kept(_from_refitted_base(rec, model, dg, far, opts), dg)
     if "mass" in fitted:
         with U.axis(model.kind):
             dg = name_mass_change(dg, model, rec, cutoff_hz=cutoff_hz, backend=backend)
@@ -207,6 +207,27 @@ def _absorbed(rec: Recording, model: Model, first: Diagnosis, opts: Options) -> 
     if kind(far["effect"]) not in {kind(f.effect) for f in dg.findings}:
         return first
     return dg if _held_out_rms(dg) <= _held_out_rms(first) else first
+
+
+def _kept(again: Diagnosis, first: Diagnosis) -> Diagnosis:
+    """The search from the refitted base, unless it lost a finding of the first pass
+    and does worse without it: on the held-out record when there is one, else on the
+    record itself, where the refitted base has more freedom than the first pass had
+    (stress seed 20, case 035: a drift named from a fitted base, the base refitted with
+    it in, 0.098 -> 0.069 N; the second pass's test of the drift fell just short and
+    left 0.105 N, the held-out record 0.448 N against the first pass's 0.231 N)."""
+    lost = {kind(f.effect) for f in first.findings} - {kind(f.effect) for f in again.findings}
+    if not lost:
+        return again
+    a, b = _held_out_rms(again), _held_out_rms(first)
+    if not (a > 0.0 and b > 0.0):
+        a, b = _rest_rms(again), _rest_rms(first)
+    return again if a <= b else first
+
+
+def _rest_rms(dg: Diagnosis) -> float:
+    """The record's force rms [N] after the findings."""
+    return float(((dg.fit or {}).get("after") or {}).get("rms_force") or 0.0)
 
 
 def _held_out_rms(dg: Diagnosis) -> float:
