@@ -292,3 +292,23 @@ def test_the_band_is_read_again_until_it_settles():
         rms = evaluate(rec, model)["rms_force"]
     assert model.mass == pytest.approx(truth.mass, rel=0.02)
     assert rms < 1.5 * res.noise < 0.15, (rms, res.noise)
+
+
+
+@pytest.mark.parametrize("seed", [1, 3])
+def test_a_damping_at_zero_gets_an_interval_from_its_profile(seed):
+    """Multiplicative profile steps never leave zero: a fitted sigma1 of 0 read
+    "determined, 0 to 0" (stress seeds 19 and 20, fits bent by a coupling or a Stribeck
+    shape they did not hold). From zero the profile steps by the damping's natural size
+    (``0.05*sqrt(sigma0*m)``, 77 N s/m here); on records of the plant with no bristle
+    damping the fit puts sigma1 at zero, and the interval reaches above it, called
+    determined only when it ends within a twentieth of that size."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = identify(plant(seed, sigma1=0.0), force_constant=20.0)
+    p = res.profiles["sigma1"]
+    assert p["value"] == 0.0, p
+    lo, hi = p["ci95"]
+    assert lo == 0.0 and hi is not None and hi > 0.0, p
+    scale = 0.05 * math.sqrt(res.model.sigma0 * res.model.mass)
+    assert p["determined"] == (hi <= 0.05 * scale), p
