@@ -220,9 +220,18 @@ def _kept(again: Diagnosis, first: Diagnosis) -> Diagnosis:
     if not lost:
         return again
     a, b = _held_out_rms(again), _held_out_rms(first)
+    where = "the held-out record"
     if not (a > 0.0 and b > 0.0):
-        a, b = _rest_rms(again), _rest_rms(first)
-    return again if a <= b else first
+        a, b, where = _rest_rms(again), _rest_rms(first), "this record"
+    if a <= b:
+        return again
+    n = U.si("N")
+    first.notes.append(
+        f"The base was also refitted where the record puts it and searched again from "
+        f"there, but that search did not name {', '.join(sorted(lost))} and left more "
+        f"on {where} ({a:.3g} {n} rms against {b:.3g} {n}): the first search is "
+        "reported, from the base as given.")
+    return first
 
 
 def _rest_rms(dg: Diagnosis) -> float:
