@@ -222,7 +222,8 @@ def _kept(again: Diagnosis, first: Diagnosis) -> Diagnosis:
     a, b = _held_out_rms(again), _held_out_rms(first)
     where = "the held-out record"
     if not (a > 0.0 and b > 0.0):
-        a, b, where = _rest_rms(again), _rest_rms(first), "this record"
+        a, b, where = _held_out_rms(again, "after"), _held_out_rms(first, "after"), \
+            "this record"
     if a <= b:
         return again
     n = U.si("N")
@@ -234,16 +235,12 @@ def _kept(again: Diagnosis, first: Diagnosis) -> Diagnosis:
     return first
 
 
-def _rest_rms(dg: Diagnosis) -> float:
-    """The record's force rms [N] after the findings."""
-    return float(((dg.fit or {}).get("after") or {}).get("rms_force") or 0.0)
-
-
-def _held_out_rms(dg: Diagnosis) -> float:
+def _held_out_rms(dg: Diagnosis, key: str = "holdout_after") -> float:
     """The held-out record's force rms [N] after the findings (0 without a held-out
     record: a second pass replaces the first only when it does as well there; a 500 Hz
-    clean record's "10 Hz current lag" did worse, 4.35 against 3.68 mN m)."""
-    after = (dg.fit or {}).get("holdout_after") or {}
+    clean record's "10 Hz current lag" did worse, 4.35 against 3.68 mN m); with
+    ``key="after"``, the record's own."""
+    after = (dg.fit or {}).get(key) or {}
     return float(after.get("rms_force") or 0.0)
 
 
