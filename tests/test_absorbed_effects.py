@@ -111,6 +111,31 @@ def test_a_timing_or_coupling_the_fit_took_in_is_named_against_that_fit(name):
     assert after < 0.5 * before, dg.fit
 
 
+def test_a_coupling_beside_a_spring_is_sized_with_the_spring_held():
+    """Stress seed 21, case 045: a fitted base that took in a coupling and a spring. The
+    first search's spring left most of the rest unexplained (not named), and the
+    coupling sized alone left 1.42 N: nothing was named (held out 2.24 -> 1.84 N). Held
+    beside the spring the rest resembled, the coupling is sized at its frequency and
+    the second search names both. (A small load friction beside them, 1.6 % on the
+    confined route, is the case's known wrong extra: DIAGNOSIS.md, session 21.)"""
+    truth = [{"effect": "resonance", "frequency": 18.032018277729065,
+              "damping_ratio": 0.03815249875876202, "load_fraction": 0.6922564295725715},
+             {"effect": "spring", "stiffness": 22.801514036427417,
+              "x0": -0.0035238481903315353}]
+    rec, hold, believed, _ = case(truth, seed=41090, axis_seed=None, kind="p2p",
+                                  duration=20.0, rate_hz=2000.0,
+                                  current_noise=0.038699352962639454, quantum=1e-07,
+                                  base_error=0.015758705404010483)
+    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    got = {f.effect: f.parameters for f in dg.findings}
+    assert {"resonance", "spring"} <= set(got), dg.summary()
+    assert got["resonance"]["frequency"] == pytest.approx(18.03, rel=0.05)
+    assert got["spring"]["stiffness"] == pytest.approx(22.80, rel=0.05)
+    assert dg.rebased and "beside it and spring" in dg.rebased["text"], dg.rebased
+    before, after = dg.fit["holdout_before"]["rms_force"], dg.fit["holdout_after"]["rms_force"]
+    assert after < 0.2 * before, dg.fit
+
+
 def _plant(seed: int, share: float | None) -> tuple[Recording, Recording, dict, dict | None]:
     c = C.draw_case(seed, max_duration=8.0, family="linear")
     axis, fr = c["truth"]["axis"], c["truth"]["friction"]
@@ -169,3 +194,21 @@ def test_a_drag_beside_a_deadband_survives_the_joint_refit():
     assert got["drag"]["coefficient"] == pytest.approx(54.0, rel=0.05)
     assert got["deadband"]["current"] == pytest.approx(0.0283, rel=0.05)
     assert dg.fit["holdout_after"]["rms_force"] < 0.2 * dg.fit["holdout_before"]["rms_force"]
+
+
+def test_a_drift_gain_is_read_with_the_levels_rescaled_beside_it():
+    """A drift's gain at its time constant, read off the base polished without it: with
+    the levels' scale beside it the warm-up's gain comes out; against the polished base
+    alone the trend reads a fraction of itself (the levels took its mean)."""
+    from lugre.diagnosis import residual as R
+    from lugre.diagnosis.absorbed import _polisher, drift_gain
+
+    eff = {"effect": "drift", "gain": 0.1, "time_constant": 3.0}
+    rec, _hold, believed, _ = case([eff], seed=41106, axis_seed=None, kind="sines",
+                                   duration=12.0, rate_hz=1000.0, current_noise=0.01)
+    sig = R.prepare(rec, believed, cutoff_hz=None, backend=None)
+    rms0, base, r0 = _polisher(sig, True)(believed, 30)
+    g = drift_gain(sig, base, r0, eff["time_constant"])
+    assert g == pytest.approx(eff["gain"], rel=0.25), g  # (a secant: the polish goes on)
+    rms1 = _polisher(sig, True)(believed.replace(effects=[{**eff, "gain": g}]), 30)[0]
+    assert rms1 < 0.5 * rms0, (rms0, rms1)

@@ -41,6 +41,7 @@ from ..vocabulary import (
     DEADBAND,
     DELAY,
     DRAG,
+    DRIFT,
     LOAD_FRICTION,
     RESONANCE,
     STRIBECK_SHAPE,
@@ -61,7 +62,7 @@ __all__ = ["ABSORBING", "absorbed_effect"]
 ABSORBING: dict[str, str] = {DEADBAND: "current", DRAG: "coefficient",
                              STRIBECK_SHAPE: "exponent", LOAD_FRICTION: "coefficient",
                              DELAY: "seconds", CURRENT_LAG: "bandwidth",
-                             RESONANCE: "frequency"}
+                             RESONANCE: "frequency", DRIFT: "time_constant"}
 
 #: Iterations of the base's polish at each size of the grid that screens the effects,
 #: and of the refinement of the best (a quick refit from the base).
@@ -104,6 +105,8 @@ def _grid(effect: str, sig: R.Signals, model: Model, start: dict[str, Any] | Non
         return np.geomspace(0.003 * f99, f99, 5) / vmax ** 2
     if effect == STRIBECK_SHAPE:
         return np.array([0.5, 1.0, 3.0, 6.0])
+    if effect == DRIFT:  # (the search's span: two held-out blocks to three records)
+        return float(sig.t[-1] - sig.t[0]) * np.geomspace(1.0 / 15.0, 3.0, 6)
     dt = float(sig.info.get("dt_logged", sig.dt))
     if effect == DELAY:
         return np.geomspace(max(0.3 * dt, 5e-5), max(10.0 * dt, 5e-3), 5)
@@ -115,6 +118,36 @@ def _grid(effect: str, sig: R.Signals, model: Model, start: dict[str, Any] | Non
 def _with(model: Model, effect: dict[str, Any], size: float) -> Model:
     return model.replace(effects=list(model.effects) + [
         {**effect, ABSORBING[effect["effect"]]: float(size)}])
+
+
+#: The trial gain from which a drift's gain is read off (a secant), and its bound.
+DRIFT_PROBE = 0.05
+DRIFT_MOST = 0.95
+
+
+def drift_gain(sig: R.Signals, base: Model, r0: np.ndarray, tau: float) -> float:
+    """The gain of a drift of time constant ``tau`` [s] that best explains ``r0``, the
+    residual of ``base``, with the friction levels re-scaled alongside (a level shift
+    and a slow trend trade off; against the polished base alone the trend reads a
+    tenth of itself): a drift scales the levels, so its force is linear in the gain
+    (the bristle state aside), read off from one trial gain as a secant, beside the
+    same secant of a drift over at once (a scale of the levels). A drift has two
+    parameters; the time constant is sized as the others are, the gain follows it."""
+    m = sig.mask
+    cols = []
+    for t in (float(tau), 1e-3 * float(sig.t[1] - sig.t[0])):
+        probe = {"effect": DRIFT, "gain": DRIFT_PROBE, "time_constant": t}
+        try:
+            r = np.asarray(sig.kernel.residual(base.replace(
+                effects=list(base.effects) + [probe])))
+        except (ValueError, ArithmeticError):  # (a model the kernel refuses)
+            return 0.0
+        cols.append((r[m] - r0[m]) / DRIFT_PROBE)
+    X = np.column_stack(cols)
+    if not np.all(np.isfinite(X)):
+        return 0.0
+    beta = np.linalg.lstsq(X, -r0[m], rcond=None)[0]
+    return float(np.clip(beta[0], -DRIFT_MOST, DRIFT_MOST))
 
 
 #: Most a polish may move the mass (a factor either way): a base that sheds its mass
@@ -132,9 +165,10 @@ class _Sizes:
     per size, and the grid's best refined between its neighbours (each polish kept by
     its size and its iterations: the screen's are short, the refinement's are not)."""
 
-    def __init__(self, start: dict[str, Any], model: Model, polish: Polisher) -> None:
+    def __init__(self, start: dict[str, Any], model: Model, polish: Polisher,
+                 base: tuple[Model, np.ndarray] | None = None) -> None:
         self.start, self.effect = start, str(start["effect"])
-        self.model, self.polish = model, polish
+        self.model, self.polish, self.base = model, polish, base
         self.seen: dict[tuple[float, int], tuple[float, Model, np.ndarray]] = {}
         self.logs = np.log(_grid(self.effect, polish.sig, model, start))
         self.rms = np.array([self.at(float(u), SCREEN_ITER) for u in self.logs])
@@ -178,8 +212,20 @@ class _Sizes:
     def at(self, log_size: float, max_iter: int = POLISH_ITER) -> float:
         key = (float(math.exp(log_size)), max_iter)
         if key not in self.seen:
-            self.seen[key] = self.polish(_with(self.model, self.start, key[0]), max_iter)
+            self.seen[key] = self.polish(_with(self.model, self._start(key[0]), key[0]),
+                                         max_iter)
         return self.seen[key][0]
+
+    def _start(self, size: float) -> dict[str, Any]:
+        """The effect's other parameters at ``size``: a drift's gain read off the base
+        polished without it (:func:`drift_gain`); the others' as started."""
+        if self.effect != DRIFT or self.base is None:
+            return self.start
+        return {**self.start, "gain": drift_gain(self.polish.sig, *self.base, size)}
+
+    def effect_at(self, size: float) -> dict[str, Any]:
+        """The effect, whole, at ``size``."""
+        return {**self._start(size), ABSORBING[self.effect]: float(size)}
 
     @property
     def best_rms(self) -> float:
@@ -220,23 +266,30 @@ def _blocks(r0: np.ndarray, r1: np.ndarray, sig: R.Signals, blocks: int) -> np.n
 def absorbed_effect(rec: Any, given: Model, augmented: Model, effects: list[dict[str, Any]],
                     *, cutoff_hz: float | None,
                     backend: Any, free_mass: bool, blocks: int, alpha: float,
-                    min_gain: float) -> dict[str, Any] | None:
+                    min_gain: float, beside: list[dict[str, Any]] = ()
+                    ) -> dict[str, Any] | None:
     """The effect of ``effects`` the fitted base of ``given`` took in, if one passes
     (module doc). Each of ``effects`` is an effect's start: its name and the
     parameters its size does not set (a resonance's damping and load share).
+    ``beside``: effects held in the model while sizing (what the rest of a first
+    search resembled without being named: a fitted base that took in two effects
+    leaves each short of the whole, stress seed 21's drag beside a drift and spring
+    beside a coupling).
 
     Returns None, or (as :func:`lugre.diagnosis.rebase.far_base`) ``model`` (the given
     model with the base fitted beside the effect; the effect itself left out),
     ``moves``, ``rms_given`` and ``rms_refit`` [N], ``text``, and ``effect`` with
-    ``size`` and ``evidence`` (the block test against the base polished without it).
+    ``size``, ``parameters`` and ``evidence`` (the block test against the base polished
+    without it).
     """
+    augmented = augmented.replace(effects=list(augmented.effects) + list(beside))
     sig = R.prepare(rec, augmented, cutoff_hz=cutoff_hz, backend=backend)
     polish = _polisher(sig, free_mass)
-    rms0, _, r0 = polish(augmented, POLISH_ITER)
+    rms0, base0, r0 = polish(augmented, POLISH_ITER)
     if not math.isfinite(rms0):
         return None
     held = {kind(e["effect"]) for e in augmented.effects}
-    tried = [_Sizes(e, augmented, polish) for e in effects
+    tried = [_Sizes(e, augmented, polish, (base0, r0)) for e in effects
              if e["effect"] in ABSORBING and kind(e["effect"]) not in held]
     if not tried:
         return None
@@ -250,13 +303,17 @@ def absorbed_effect(rec: Any, given: Model, augmented: Model, effects: list[dict
     ok, _ = accept(ev, alpha=alpha, min_gain=min_gain)
     if not (ok and rms1 < (1.0 - REBASE_GAIN) * rms0):
         return None
-    best = {"effect": top.effect, "size": size, "rms_refit": rms1, "evidence": ev}
+    eff = top.effect_at(size)
+    best = {"effect": top.effect, "size": size, "rms_refit": rms1, "evidence": ev,
+            "parameters": {k: v for k, v in eff.items() if k != "effect"}}
     refit = apply_base(given, {n: get_base(fitted, n) for n, _ in BASE_PARAMS})
     moves = _moves(given, refit, base_names(free_mass))
     name = ABSORBING[best["effect"]]
     size = U.fmt(best["size"], U.unit_of(best["effect"], name), 3)
-    text = (f"the fitted base had bent itself to mimic {best['effect']} (a {name} of "
-            f"about {size}): refitted beside it, the {U.force_words()} residual falls from "
-            f"{rms0:.3g} to {best['rms_refit']:.3g} {U.si('N')} rms. The search was run "
-            "again from that base, so that no base parameter stands in for the effect")
+    with_too = "".join(f" and {e['effect']}" for e in beside)
+    text = (f"the fitted base had bent itself to mimic {best['effect']} (a "
+            f"{name.replace('_', ' ')} of about {size}): refitted beside it{with_too}, the "
+            f"{U.force_words()} residual falls from {rms0:.3g} to {best['rms_refit']:.3g} "
+            f"{U.si('N')} rms. The search was run again from that base, so that no base "
+            "parameter stands in for the effect")
     return {**best, "model": refit, "moves": moves, "rms_given": rms0, "text": text}

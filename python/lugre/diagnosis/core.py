@@ -197,16 +197,33 @@ def _absorbed(rec: Recording, model: Model, first: Diagnosis, opts: Options) -> 
     """A fitted base that bent itself to mimic an effect: those the base can mimic whose
     trials gained without being named, sized with the base fitted beside them; the
     search run again from the base beside the best, and kept when it names the effect."""
-    far = absorbed_effect(rec, model, first.augmented, _absorbed_starts(first, opts),
-                          cutoff_hz=opts.cutoff_hz, backend=opts.backend,
-                          free_mass=opts.free_mass, blocks=opts.blocks, alpha=opts.alpha,
-                          min_gain=opts.min_gain)
+    starts = _absorbed_starts(first, opts)
+    # alone first, then beside what the rest resembled (a wrong resemblance held in can
+    # spoil an effect that stands alone: stress seed 15's dead-band beside a "current
+    # limit")
+    resembled = _resembled(first)
+    for beside in [[], resembled] if resembled else [[]]:
+        far = absorbed_effect(rec, model, first.augmented, starts,
+                              cutoff_hz=opts.cutoff_hz, backend=opts.backend,
+                              free_mass=opts.free_mass, blocks=opts.blocks,
+                              alpha=opts.alpha, min_gain=opts.min_gain, beside=beside)
+        if far is not None:
+            break
     if far is None:
         return first
     dg = _from_refitted_base(rec, model, first, far, opts)
     if kind(far["effect"]) not in {kind(f.effect) for f in dg.findings}:
         return first
     return dg if _held_out_rms(dg) <= _held_out_rms(first) else first
+
+
+def _resembled(first: Diagnosis) -> list[dict[str, Any]]:
+    """What the rest of a search that named nothing resembled (accepted terms that left
+    most of it unexplained), as effects to hold while an absorbed effect is sized."""
+    if first.findings:
+        return []
+    rest = first.unexplained or {}
+    return [{"effect": r["effect"], **r["parameters"]} for r in rest.get("resembles") or []]
 
 
 def _kept(again: Diagnosis, first: Diagnosis) -> Diagnosis:
