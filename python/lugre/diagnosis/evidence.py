@@ -49,7 +49,7 @@ def base_report(model: Model, base: dict[str, float], free: list[str],
                   "tolerance": rel, "unit": U.si(B.unit(n)), "status": status}
     out["sigma1"]["presliding_test"] = {k: presliding[k] for k in
                                         ("gain", "min_gain", "alpha", "p", "positive",
-                                         "blocks", "free", "for_lag")
+                                         "blocks", "free", "for_lag", "beside")
                                         if k in presliding}
     return out
 
@@ -88,11 +88,17 @@ def base_notes(base: dict[str, dict[str, Any]], findings: list[Any]) -> list[str
                     "for it); the refitted values are in the augmented model.")
         notes.append(txt)
     s1 = base["sigma1"]
-    if s1.get("presliding_test", {}).get("for_lag"):
+    pt = s1.get("presliding_test", {})
+    if pt.get("for_lag"):
         notes.append(U.words(
             "sigma0 and sigma1 (presliding stiffness and damping), which lugre fit took "
             "from this record, were refitted beside the lag: at the reversals a lag and a "
             "larger bristle damping read much alike, and the fit had taken the damping."))
+    elif pt.get("beside") and pt.get("free"):
+        notes.append(U.words(
+            "sigma0 and sigma1 (presliding stiffness and damping), which lugre fit took "
+            f"from this record, were refitted beside {' and '.join(pt['beside'])}: held "
+            "where the fit put them, they kept that from being named."))
     if "not determined" in s1["status"]:
         pt = s1.get("presliding_test", {})
         blocks = (f"gains in {pt.get('positive', 0)} of {pt.get('blocks', 10)} stretches, "
