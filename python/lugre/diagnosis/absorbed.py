@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -266,7 +267,7 @@ def _blocks(r0: np.ndarray, r1: np.ndarray, sig: R.Signals, blocks: int) -> np.n
 def absorbed_effect(rec: Any, given: Model, augmented: Model, effects: list[dict[str, Any]],
                     *, cutoff_hz: float | None,
                     backend: Any, free_mass: bool, blocks: int, alpha: float,
-                    min_gain: float, beside: list[dict[str, Any]] = ()
+                    min_gain: float, beside: Sequence[dict[str, Any]] = ()
                     ) -> dict[str, Any] | None:
     """The effect of ``effects`` the fitted base of ``given`` took in, if one passes
     (module doc). Each of ``effects`` is an effect's start: its name and the
@@ -304,16 +305,17 @@ def absorbed_effect(rec: Any, given: Model, augmented: Model, effects: list[dict
     if not (ok and rms1 < (1.0 - REBASE_GAIN) * rms0):
         return None
     eff = top.effect_at(size)
-    best = {"effect": top.effect, "size": size, "rms_refit": rms1, "evidence": ev,
-            "parameters": {k: v for k, v in eff.items() if k != "effect"}}
+    best: dict[str, Any] = {
+        "effect": top.effect, "size": size, "rms_refit": rms1, "evidence": ev,
+        "parameters": {k: v for k, v in eff.items() if k != "effect"}}
     refit = apply_base(given, {n: get_base(fitted, n) for n, _ in BASE_PARAMS})
     moves = _moves(given, refit, base_names(free_mass))
-    name = ABSORBING[best["effect"]]
-    size = U.fmt(best["size"], U.unit_of(best["effect"], name), 3)
+    name = ABSORBING[top.effect]
+    shown = U.fmt(size, U.unit_of(top.effect, name), 3)
     with_too = "".join(f" and {e['effect']}" for e in beside)
-    text = (f"the fitted base had bent itself to mimic {best['effect']} (a "
-            f"{name.replace('_', ' ')} of about {size}): refitted beside it{with_too}, the "
-            f"{U.force_words()} residual falls from {rms0:.3g} to {best['rms_refit']:.3g} "
+    text = (f"the fitted base had bent itself to mimic {top.effect} (a "
+            f"{name.replace('_', ' ')} of about {shown}): refitted beside it{with_too}, the "
+            f"{U.force_words()} residual falls from {rms0:.3g} to {rms1:.3g} "
             f"{U.si('N')} rms. The search was run again from that base, so that no base "
             "parameter stands in for the effect")
     return {**best, "model": refit, "moves": moves, "rms_given": rms0, "text": text}
