@@ -467,9 +467,14 @@ impl Record {
         for (&j, r) in coupled.iter().zip(done) {
             out[j] = Some(r);
         }
-        // the others: friction and effect forces, low-passed side by side
+        // the others: friction and effect forces, low-passed side by side, in chunks
+        // small enough to keep every thread busy (a batch of four on two threads ran on
+        // one)
+        let lanes = LANES
+            .min(plain.len().div_ceil(rayon::current_num_threads().max(1)))
+            .max(1);
         let done: Vec<(usize, Vec<f64>)> = plain
-            .par_chunks(LANES)
+            .par_chunks(lanes)
             .flat_map_iter(|chunk| {
                 let ms: Vec<&Model> = chunk.iter().map(|&j| &models[j]).collect();
                 let raw = (0..chunk.len())
@@ -696,6 +701,18 @@ mod tests {
         });
         let all = rec.residuals(&models).unwrap();
         for (m, r) in models.iter().zip(&all) {
+            assert_eq!(&rec.residual(m).unwrap(), r);
+        }
+        // more plain models than lanes: chunks sized to the threads, the same numbers
+        let many: Vec<Model> = (0..7)
+            .map(|k| {
+                let mut m = Model::paper();
+                m.effects.push(Effect::Offset { force: k as f64 });
+                m
+            })
+            .collect();
+        let all = rec.residuals(&many).unwrap();
+        for (m, r) in many.iter().zip(&all) {
             assert_eq!(&rec.residual(m).unwrap(), r);
         }
     }
