@@ -126,28 +126,39 @@ DRIFT_PROBE = 0.05
 DRIFT_MOST = 0.95
 
 
-def drift_gain(sig: R.Signals, base: Model, r0: np.ndarray, tau: float) -> float:
+def drift_column(sig: R.Signals, base: Model, r0: np.ndarray, tau: float
+                 ) -> np.ndarray | None:
+    """What a drift of time constant ``tau`` [s] and unit gain changes in ``r0``, the
+    residual of ``base`` (a secant from :data:`DRIFT_PROBE`), at the masked samples;
+    None where the kernel refuses it."""
+    probe = {"effect": DRIFT, "gain": DRIFT_PROBE, "time_constant": float(tau)}
+    try:
+        r = np.asarray(sig.kernel.residual(base.replace(effects=list(base.effects) + [probe])))
+    except (ValueError, ArithmeticError):  # (a model the kernel refuses)
+        return None
+    col = (r[sig.mask] - r0[sig.mask]) / DRIFT_PROBE
+    return col if np.all(np.isfinite(col)) else None
+
+
+def level_scale(sig: R.Signals, base: Model, r0: np.ndarray) -> np.ndarray | None:
+    """:func:`drift_column` of a drift that is over at once: a scale of the levels."""
+    return drift_column(sig, base, r0, 1e-3 * float(sig.t[1] - sig.t[0]))
+
+
+def drift_gain(sig: R.Signals, base: Model, r0: np.ndarray, tau: float,
+               scale: np.ndarray | None = None) -> float:
     """The gain of a drift of time constant ``tau`` [s] that best explains ``r0``, the
     residual of ``base``, with the friction levels re-scaled alongside (a level shift
     and a slow trend trade off; against the polished base alone the trend reads a
     tenth of itself): a drift scales the levels, so its force is linear in the gain
-    (the bristle state aside), read off from one trial gain as a secant, beside the
-    same secant of a drift over at once (a scale of the levels). A drift has two
+    (the bristle state aside), read off from one trial gain as a secant, beside
+    ``scale`` (:func:`level_scale`, computed here when not given). A drift has two
     parameters; the time constant is sized as the others are, the gain follows it."""
-    m = sig.mask
-    cols = []
-    for t in (float(tau), 1e-3 * float(sig.t[1] - sig.t[0])):
-        probe = {"effect": DRIFT, "gain": DRIFT_PROBE, "time_constant": t}
-        try:
-            r = np.asarray(sig.kernel.residual(base.replace(
-                effects=list(base.effects) + [probe])))
-        except (ValueError, ArithmeticError):  # (a model the kernel refuses)
-            return 0.0
-        cols.append((r[m] - r0[m]) / DRIFT_PROBE)
-    X = np.column_stack(cols)
-    if not np.all(np.isfinite(X)):
+    scale = level_scale(sig, base, r0) if scale is None else scale
+    col = drift_column(sig, base, r0, tau)
+    if col is None or scale is None:
         return 0.0
-    beta = np.linalg.lstsq(X, -r0[m], rcond=None)[0]
+    beta = np.linalg.lstsq(np.column_stack([col, scale]), -r0[sig.mask], rcond=None)[0]
     return float(np.clip(beta[0], -DRIFT_MOST, DRIFT_MOST))
 
 
@@ -170,6 +181,9 @@ class _Sizes:
                  base: tuple[Model, np.ndarray] | None = None) -> None:
         self.start, self.effect = start, str(start["effect"])
         self.model, self.polish, self.base = model, polish, base
+        # (a drift's gain is read beside a scale of the levels, the same at every size)
+        self.scale = (level_scale(polish.sig, *base) if self.effect == DRIFT
+                      and base is not None else None)
         self.seen: dict[tuple[float, int], tuple[float, Model, np.ndarray]] = {}
         self.logs = np.log(_grid(self.effect, polish.sig, model, start))
         self.rms = np.array([self.at(float(u), SCREEN_ITER) for u in self.logs])
@@ -222,7 +236,10 @@ class _Sizes:
         polished without it (:func:`drift_gain`); the others' as started."""
         if self.effect != DRIFT or self.base is None:
             return self.start
-        return {**self.start, "gain": drift_gain(self.polish.sig, *self.base, size)}
+        if self.scale is None:
+            return {**self.start, "gain": 0.0}
+        return {**self.start, "gain": drift_gain(self.polish.sig, *self.base, size,
+                                                 self.scale)}
 
     def effect_at(self, size: float) -> dict[str, Any]:
         """The effect, whole, at ``size``."""

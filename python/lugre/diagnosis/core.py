@@ -167,16 +167,14 @@ def _far(rec: Recording, model: Model, dg: Diagnosis, fitted: bool,
     until it is refitted with them. (A base given as believed is not refitted on a
     resemblance: beside physics outside the vocabulary, the levels would bend to it.)"""
     far = far_base(rec, model, dg.augmented, **kw)
-    rest = dg.unexplained or {}
-    alike = rest.get("resembles") or []
-    if far is not None or dg.findings or not alike or not fitted:
+    held = _resembled(dg)
+    if far is not None or not held or not fitted:
         return far
     # (the refit must beat the rest the first pass left, not the resembled terms' joint
     # on the bent base: outside the vocabulary that joint can be far worse than either)
-    held = [{"effect": r["effect"], **r["parameters"]} for r in alike]
     return far_base(rec, model, dg.augmented.replace(
         effects=list(dg.augmented.effects) + held), held="the effects it resembles",
-        rms_before=float(rest["rms_force"]), **kw)
+        rms_before=float((dg.unexplained or {})["rms_force"]), **kw)
 
 
 def _from_refitted_base(rec: Recording, model: Model, first: Diagnosis, far: dict[str, Any],

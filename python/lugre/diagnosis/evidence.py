@@ -94,7 +94,7 @@ def base_notes(base: dict[str, dict[str, Any]], findings: list[Any]) -> list[str
             "sigma0 and sigma1 (presliding stiffness and damping), which lugre fit took "
             "from this record, were refitted beside the lag: at the reversals a lag and a "
             "larger bristle damping read much alike, and the fit had taken the damping."))
-    elif pt.get("beside") and pt.get("free"):
+    elif pt.get("beside"):
         notes.append(U.words(
             "sigma0 and sigma1 (presliding stiffness and damping), which lugre fit took "
             f"from this record, were refitted beside {' and '.join(pt['beside'])}: held "
