@@ -17,6 +17,7 @@ import sys
 import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
 from lugre.diagnosis import diagnose, fit_model
 from lugre.diagnosis.absorbed import ABSORBING
@@ -134,6 +135,79 @@ def test_a_coupling_beside_a_spring_is_sized_with_the_spring_held():
     assert dg.rebased and "beside it and spring" in dg.rebased["text"], dg.rebased
     before, after = dg.fit["holdout_before"]["rms_force"], dg.fit["holdout_after"]["rms_force"]
     assert after < 0.2 * before, dg.fit
+
+
+def _held_out(dg: object) -> tuple[float, float]:
+    return dg.fit["holdout_before"]["rms_force"], dg.fit["holdout_after"]["rms_force"]
+
+
+def test_a_coupling_whose_trial_lost_against_the_bent_base_is_sized():
+    """Stress seed 23, case 042: a 29.3 Hz coupling on a 6 s point-to-point record. The
+    fit gave sigma1 = 0 and a softer sigma0, and against that base the resonance trial
+    lost at every frequency: no start for the absorbed stage, "unexplained" (0.38 N
+    held out). Where the search leaves the record unexplained, the resonance is sized
+    from its trial's frequency all the same."""
+    truth = {"effect": "resonance", "frequency": 29.280573104767917,
+             "damping_ratio": 0.06716422355279661, "load_fraction": 0.6048048514981181}
+    rec, hold, believed, _ = case([truth], seed=43084, axis_seed=8756, kind="p2p",
+                                  duration=6.0, rate_hz=1000.0,
+                                  current_noise=0.0040866957595806575, quantum=1e-07,
+                                  base_error=0.006073485933775821)
+    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    got = {f.effect: f.parameters for f in dg.findings}
+    assert list(got) == ["resonance"], dg.summary()
+    assert got["resonance"]["frequency"] == pytest.approx(29.28, rel=0.1)
+    assert dg.rebased and "resonance" in dg.rebased["text"], dg.rebased
+    before, after = _held_out(dg)
+    assert after < 0.3 * before, dg.fit
+
+
+def test_a_delay_in_a_base_fitted_near_its_floor_is_named():
+    """Stress seed 23, case 025: a 1.31 ms delay in a record the fit took to 1.3 times
+    its noise floor. Beside a lag the base's residual fell from 0.131 to 0.107 N: 61 %
+    of its excess over the floor, but not the fifth of its rms the stage asked, and
+    nothing was named (0.16 N held out where the true model with the delay reaches
+    0.11 N). The stage also takes half the excess over the floor."""
+    truth = {"effect": "delay", "seconds": 0.0013134481143544422}
+    rec, hold, believed, _ = case([truth], seed=43050, axis_seed=4545, kind="p2p",
+                                  duration=10.0, rate_hz=2000.0,
+                                  current_noise=0.005275814150924591, quantum=1e-06,
+                                  base_error=0.007570479097147127)
+    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    got = {kind(f.effect): f.parameters for f in dg.findings}
+    assert list(got) == [kind("delay")], dg.summary()
+    assert got[kind("delay")]["seconds"] == pytest.approx(truth["seconds"], rel=0.15)
+    assert dg.rebased, dg.summary()
+    before, after = _held_out(dg)
+    assert after < 0.7 * before, dg.fit
+
+
+def test_an_absorbed_delay_is_named_on_its_own_test_beside_a_bump():
+    """Stress seed 22, case 045: a 1.12 ms delay beside a 16 % friction bump, 20 s of
+    sines at 5 kHz. The lag sized beside the refitted base passed its own test (10 of
+    10 stretches, p = 0.0006), but the second search's quicker refit lost one block
+    (9 of 10, p = 0.13): only the bump was named (0.12 N held out, 0.033 N with the
+    true model). An attested kind is named on most blocks, and its finding says so."""
+    bump = [1.0017729729053477, 1.0036379041947774, 1.0070122438683096,
+            1.0126975332861623, 1.0215992317118894, 1.0345154739980287,
+            1.0518138633223222, 1.0730692590272213, 1.0968010406908741,
+            1.120470841592477, 1.140844683131329, 1.154687622574503,
+            1.1595979348129528]
+    truth = [{"effect": "delay", "seconds": 0.0011241871500546764},
+             {"effect": "position_friction",
+              "positions": list(-0.10433235354639793 + 0.005625 * np.arange(25)),
+              "scale": bump + bump[-2::-1]}]
+    rec, hold, believed, _ = case(truth, seed=42090, axis_seed=None, kind="sines",
+                                  duration=20.0, rate_hz=5000.0,
+                                  current_noise=0.004586628031802712, quantum=1e-07,
+                                  base_error=0.018972492282081626)
+    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    got = {kind(f.effect): f for f in dg.findings}
+    assert set(got) == {kind("delay"), "position_friction"}, dg.summary()
+    assert got[kind("delay")].parameters["seconds"] == pytest.approx(1.124e-3, rel=0.15)
+    assert "named on its own test" in got[kind("delay")].evidence
+    before, after = _held_out(dg)
+    assert after < 0.05 * before, dg.fit
 
 
 def _plant(seed: int, share: float | None) -> tuple[Recording, Recording, dict, dict | None]:

@@ -37,8 +37,10 @@ ROWS_KEPT = 100_000
 @dataclass(frozen=True)
 class Options:
     """What the caller of :func:`lugre.diagnose` asked for (its keywords, documented
-    there), and ``question``: whether the model's own effects are questioned (not in
-    the search for one kind that questioning runs)."""
+    there), ``question``: whether the model's own effects are questioned (not in
+    the search for one kind that questioning runs), and ``attested``: kinds whose own
+    test beside a polished base already passed (the absorbed-effect stage's), which the
+    search names on fewer consistent blocks (:data:`lugre.diagnosis.search.ATTESTED`)."""
 
     holdout: Any = None
     cutoff_hz: float | None = None
@@ -53,6 +55,7 @@ class Options:
     tolerance: float = 1.0
     backend: Any = "core"
     question: bool = True
+    attested: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.candidates is not None and not isinstance(self.candidates, tuple):

@@ -5,6 +5,7 @@ minor corrections."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -12,6 +13,7 @@ import numpy as np
 
 from .. import units as U
 from ..exceptions import DataError, LugreError, ParameterError
+from ..vocabulary import kind
 from .candidates import Candidate, Context, Term
 from .colcache import (
     contribution_rms,
@@ -148,6 +150,7 @@ class _Rules:
     min_effect: float
     min_force: float
     dt: float  # the record's own sample interval [s]
+    attested: frozenset[str] = frozenset()  # kinds whose own test passed (ATTESTED)
 
 
 @dataclass
@@ -194,6 +197,8 @@ def _try_columns(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidat
     trial = kept + [term]
     evid = compare(cur, ev, scorer.s2)
     ok, why = accept(evid, alpha=rules.alpha, min_gain=rules.min_gain)
+    if not ok and kind(c.effect) in rules.attested and _attested(evid, rules):
+        ok, why = True, ATTESTED_WHY
     start = scorer.J.shape[1] + sum(t.X.shape[1] for t in trial[:-1])
     beta = ev.beta[start:start + term.X.shape[1]]
     contrib = contribution_rms(term, beta, scorer.mask, ctx)
@@ -236,6 +241,23 @@ def _try_columns(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidat
                   bad=bad)
 
 
+#: Share of the held-out blocks in which an attested kind must gain (with a gain over
+#: ``min_gain``) to be named when its blocks are not consistent: its own test, the base
+#: polished beside it against the base polished without it, already passed (the
+#: absorbed-effect stage, :mod:`lugre.diagnosis.absorbed`), and the search's linearised
+#: refit of the base can lose one block that the polished base does not (stress seed 22,
+#: case 045: a 1.2 ms delay beside a friction bump, its own test 10 of 10 blocks at
+#: p = 0.0006, the search's 9 of 10 at p = 0.13 for one block's loss).
+ATTESTED = 0.8
+ATTESTED_WHY = ("consistent over blocks with the base polished beside it (its own test); "
+                "here gaining in most held-out blocks")
+
+
+def _attested(evid: dict[str, Any], rules: _Rules) -> bool:
+    return bool(evid["gain"] > rules.min_gain
+                and evid["positive"] >= ATTESTED * evid["blocks"])
+
+
 def _spread(scorer: Scorer, contrib: np.ndarray, ctx: Context, ok: bool, why: str
             ) -> tuple[bool, str]:
     """A term most of whose addition lives in one held-out stretch is not named."""
@@ -260,6 +282,7 @@ def forward_select(
     noise_rms: float = 0.0,
     min_effect: float = 0.2,
     min_force: float = 0.0,
+    attested: Sequence[str] = (),
 ) -> tuple[list[Term], Evaluation, list[dict[str, Any]]]:
     """Greedy forward selection of effect terms.
 
@@ -284,6 +307,8 @@ def forward_select(
     min_force : float, default 0.0
         Least rms contribution of a term [N] (practical relevance: an effect far below
         what the motor gives is not worth a term, however significant).
+    attested : sequence of str, default ()
+        Kinds whose own test already passed (:data:`ATTESTED`).
 
     Returns
     -------
@@ -296,7 +321,8 @@ def forward_select(
     """
     rules = _Rules(alpha=alpha, min_gain=min_gain, noise_rms=noise_rms,
                    min_effect=min_effect, min_force=min_force,
-                   dt=ctx.sig.info.get("dt_logged", ctx.sig.dt))
+                   dt=ctx.sig.info.get("dt_logged", ctx.sig.dt),
+                   attested=frozenset(attested))
     terms: list[Term] = []
     cur = scorer.evaluate(terms)
     log: list[dict[str, Any]] = []

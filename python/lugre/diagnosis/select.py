@@ -70,7 +70,8 @@ def candidates(w: Weighing, opts: Options) -> tuple[list[E.Candidate], set[str]]
 def _searcher(w: Weighing, scorer: Any, opts: Options) -> Any:
     def run(cands: list[E.Candidate]) -> tuple[list[Term], Evaluation, list[dict[str, Any]]]:
         return forward_select(scorer, w.ctx, cands, alpha=opts.alpha, min_gain=opts.min_gain,
-                              noise_rms=w.noise["rms"], min_force=w.min_force)
+                              noise_rms=w.noise["rms"], min_force=w.min_force,
+                              attested=opts.attested)
     return run
 
 
