@@ -210,6 +210,26 @@ def test_an_absorbed_delay_is_named_on_its_own_test_beside_a_bump():
     assert after < 0.05 * before, dg.fit
 
 
+def test_a_deadband_sized_beside_a_stribeck_shape_starts_a_sound_search():
+    """Stress seed 22, case 047: a 76 mA dead-band beside a Stribeck exponent of 0.9.
+    The dead-band was sized beside the exponent the rest resembled (0.25 -> 0.096 N),
+    but the second search started from that base without the exponent, 2.7 N off, and
+    named nothing. It now starts from the base polished beside the dead-band alone."""
+    truth = [{"effect": "deadband", "current": 0.07616372799468052},
+             {"effect": "stribeck_shape", "exponent": 0.9}]
+    rec, hold, believed, _ = case(truth, seed=42094, axis_seed=None, kind="sines",
+                                  duration=30.0, rate_hz=2000.0,
+                                  current_noise=0.016411177146353526, quantum=5e-06,
+                                  base_error=0.005241671559467986)
+    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    got = {f.effect: f.parameters for f in dg.findings}
+    assert set(got) == {"deadband", "stribeck_shape"}, dg.summary()
+    assert got["deadband"]["current"] == pytest.approx(0.0762, rel=0.3)
+    assert dg.rebased and "beside it and stribeck_shape" in dg.rebased["text"]
+    before, after = _held_out(dg)
+    assert after < 0.7 * before, dg.fit
+
+
 def _plant(seed: int, share: float | None) -> tuple[Recording, Recording, dict, dict | None]:
     c = C.draw_case(seed, max_duration=8.0, family="linear")
     axis, fr = c["truth"]["axis"], c["truth"]["friction"]
