@@ -302,6 +302,32 @@ def _blocks(r0: np.ndarray, r1: np.ndarray, sig: R.Signals, blocks: int) -> np.n
     return np.array([(np.sum(r0[p] ** 2) - np.sum(r1[p] ** 2)) / s2 for p in parts])
 
 
+#: The most effects of the screen refined and tested, best first.
+REFINED_MOST = 2
+
+
+def _tested(top: _Sizes, sig: R.Signals, given: tuple[float, np.ndarray, float],
+            blocks: int, alpha: float, min_gain: float
+            ) -> tuple[float, float, Model, dict[str, Any]] | None:
+    """``top`` refined and tested against the base polished without it (``given``: its
+    rms [N], residual and noise floor [N]): (size, rms [N], polished base, block
+    evidence), or None. The excess over the noise floor, each residual's own, must fall
+    too: a coupling or a lag filters the recorded current's noise on its way to the
+    load, and can lower the rms by that alone (stress seed 24, case 040: a 29.6 Hz
+    "coupling" took a fitted base's 0.289 N to 0.193 N with a drag in the record, its
+    floor from 0.269 to 0.167 N, the rest above the floor from 0.105 to 0.097 N)."""
+    rms0, r0, floor = given
+    size, rms1, fitted, r1 = top.refined()
+    ev = block_evidence(_blocks(r0, r1, sig, blocks))
+    ok, _ = accept(ev, alpha=alpha, min_gain=min_gain)
+    if not (ok and _lowers(rms1, rms0, floor)):
+        return None
+    own = R.noise_floor(r1, sig)["rms"]
+    if rms1 ** 2 - own ** 2 > (1.0 - 0.5 * EXCESS_SHARE) * (rms0 ** 2 - floor ** 2):
+        return None
+    return size, rms1, fitted, ev
+
+
 def _without_beside(polish: Polisher, alone: Model, effect: dict[str, Any],
                     fitted: Model) -> Model:
     """The base polished beside ``effect`` alone, from where it was fitted beside the
@@ -345,17 +371,19 @@ def absorbed_effect(rec: Any, given: Model, augmented: Model, effects: list[dict
              if e["effect"] in ABSORBING and kind(e["effect"]) not in held]
     if not tried:
         return None
-    # the grids screen the effects; only the best is refined and tested, when its
-    # screen took half of what the test asks already
-    top = min(tried, key=lambda z: z.best_rms)
+    # the grids screen the effects; the best are refined and tested, when their screen
+    # took half of what the test asks already
     floor = R.noise_floor(r0, sig)["rms"]
-    if not _lowers(top.best_rms, rms0, floor, 0.5) or top.at_edge:
-        return None  # (too little, or a size the grid does not bracket)
-    size, rms1, fitted, r1 = top.refined()
-    ev = block_evidence(_blocks(r0, r1, sig, blocks))
-    ok, _ = accept(ev, alpha=alpha, min_gain=min_gain)
-    if not (ok and _lowers(rms1, rms0, floor)):
+    passed = None
+    for top in sorted(tried, key=lambda z: z.best_rms)[:REFINED_MOST]:
+        if not _lowers(top.best_rms, rms0, floor, 0.5) or top.at_edge:
+            break  # (too little, or a size the grid does not bracket)
+        passed = _tested(top, sig, (rms0, r0, floor), blocks, alpha, min_gain)
+        if passed is not None:
+            break
+    if passed is None:
         return None
+    size, rms1, fitted, ev = passed
     eff = top.effect_at(size)
     best: dict[str, Any] = {
         "effect": top.effect, "size": size, "rms_refit": rms1, "evidence": ev,
