@@ -255,6 +255,30 @@ def test_a_coupling_is_sized_beside_what_the_rest_resembled_when_alone_fails():
     assert after < 0.6 * before, dg.fit
 
 
+def test_a_drift_sized_beside_a_spring_is_searched_from_the_base_beside_both():
+    """Stress seed 25, case 046: a warm-up drift beside an 18.6 N/m spring, 30 s of
+    sines. The drift is sized beside the spring the rest resembled (0.66 -> 0.08 N).
+    From the base polished again beside the drift alone, the base bent to the spring
+    once more, and the search named a lag and a load friction beside the two (0.17 N
+    held out); from the base fitted beside both it names the two alone. Both are
+    searched; the one that leaves less is kept."""
+    truth = [{"effect": "drift", "gain": 0.10952103684861492,
+              "time_constant": 3.9545214138592537},
+             {"effect": "spring", "stiffness": 18.61475389102747,
+              "x0": 0.018607364231180062}]
+    rec, hold, believed, _ = case(truth, seed=45092, axis_seed=None, kind="sines",
+                                  duration=30.0, rate_hz=2000.0,
+                                  current_noise=0.011268035451713612, quantum=5e-06,
+                                  base_error=0.011389292740645074)
+    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    got = {f.effect: f.parameters for f in dg.findings}
+    assert set(got) == {"drift", "spring"}, dg.summary()
+    assert got["drift"]["gain"] == pytest.approx(0.1095, rel=0.3)
+    assert got["spring"]["stiffness"] == pytest.approx(18.61, rel=0.1)
+    before, after = _held_out(dg)
+    assert after < 0.15 * before, dg.fit
+
+
 def test_a_coupling_that_only_filters_the_current_noise_is_not_absorbed():
     """Stress seed 24, case 040: a drag, and a fit at 1.1 times its noise floor. Sized
     beside the fitted base, a 29.6 Hz coupling took the residual from 0.289 to 0.193 N
