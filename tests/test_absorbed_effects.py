@@ -164,7 +164,7 @@ def test_a_coupling_whose_trial_lost_against_the_bent_base_is_sized():
 
 def test_a_delay_in_a_base_fitted_near_its_floor_is_named():
     """Stress seed 23, case 025: a 1.31 ms delay in a record the fit took to 1.3 times
-    its noise floor. Beside a lag the base's residual fell from 0.131 to 0.107 N: 61 %
+    its noise floor. Beside a lag the base's residual fell from 0.131 to 0.107 N: 86 %
     of its excess over the floor, but not the fifth of its rms the stage asked, and
     nothing was named (0.16 N held out where the true model with the delay reaches
     0.11 N). The stage also takes half the excess over the floor."""
