@@ -51,6 +51,16 @@ def _chain(rec: Recording, force_constant: float, controller: dict | None,
         return diagnose(rec, fitted, holdout=hold)
 
 
+def _stress_chain(effects: list[dict], **setup: object) -> object:
+    """A stress case (:func:`lugre.diagnosis.synth.case`) through the chain."""
+    rec, hold, believed, _ = case(effects, **setup)
+    return _chain(rec, believed.force_constant, believed.controller, hold)
+
+
+def _held_out(dg: object) -> tuple[float, float]:
+    return dg.fit["holdout_before"]["rms_force"], dg.fit["holdout_after"]["rms_force"]
+
+
 def _named(dg: object, effect: dict, tol: float, rebased: bool = True) -> None:
     name, key = effect["effect"], ABSORBING[effect["effect"]]
     got = {f.effect: f.parameters for f in dg.findings}
@@ -63,12 +73,11 @@ def _named(dg: object, effect: dict, tol: float, rebased: bool = True) -> None:
 @pytest.mark.parametrize("name", sorted(STRESS))
 def test_an_effect_the_fit_took_in_is_named_against_that_fit(name):
     setup, effect = STRESS[name]
-    rec, hold, believed, _ = case([effect], **setup)
-    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    dg = _stress_chain([effect], **setup)
     # (since session 18 the fit sets a drag aside itself: the diagnosis names it from
     # a sound base, without the stage)
     _named(dg, effect, 0.05, rebased=name != "drag")
-    before, after = dg.fit["holdout_before"]["rms_force"], dg.fit["holdout_after"]["rms_force"]
+    before, after = _held_out(dg)
     assert after < 0.5 * before, dg.fit
 
 
@@ -101,14 +110,13 @@ SIZED = {
 @pytest.mark.parametrize("name", sorted(SIZED))
 def test_a_timing_or_coupling_the_fit_took_in_is_named_against_that_fit(name):
     setup, effect, tol = SIZED[name]
-    rec, hold, believed, _ = case([effect], **setup)
-    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    dg = _stress_chain([effect], **setup)
     key = ABSORBING[effect["effect"]]
     got = {kind(f.effect): f.parameters for f in dg.findings}
     assert list(got) == [kind(effect["effect"])], dg.summary()
     assert got[kind(effect["effect"])][key] == pytest.approx(effect[key], rel=tol), got
     assert dg.rebased and effect["effect"] in dg.rebased["text"], dg.rebased
-    before, after = dg.fit["holdout_before"]["rms_force"], dg.fit["holdout_after"]["rms_force"]
+    before, after = _held_out(dg)
     assert after < 0.5 * before, dg.fit
 
 
@@ -123,22 +131,17 @@ def test_a_coupling_beside_a_spring_is_sized_with_the_spring_held():
               "damping_ratio": 0.03815249875876202, "load_fraction": 0.6922564295725715},
              {"effect": "spring", "stiffness": 22.801514036427417,
               "x0": -0.0035238481903315353}]
-    rec, hold, believed, _ = case(truth, seed=41090, axis_seed=None, kind="p2p",
-                                  duration=20.0, rate_hz=2000.0,
-                                  current_noise=0.038699352962639454, quantum=1e-07,
-                                  base_error=0.015758705404010483)
-    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    dg = _stress_chain(truth, seed=41090, axis_seed=None, kind="p2p",
+                       duration=20.0, rate_hz=2000.0,
+                       current_noise=0.038699352962639454, quantum=1e-07,
+                       base_error=0.015758705404010483)
     got = {f.effect: f.parameters for f in dg.findings}
     assert {"resonance", "spring"} <= set(got), dg.summary()
     assert got["resonance"]["frequency"] == pytest.approx(18.03, rel=0.05)
     assert got["spring"]["stiffness"] == pytest.approx(22.80, rel=0.05)
     assert dg.rebased and "beside it and spring" in dg.rebased["text"], dg.rebased
-    before, after = dg.fit["holdout_before"]["rms_force"], dg.fit["holdout_after"]["rms_force"]
+    before, after = _held_out(dg)
     assert after < 0.2 * before, dg.fit
-
-
-def _held_out(dg: object) -> tuple[float, float]:
-    return dg.fit["holdout_before"]["rms_force"], dg.fit["holdout_after"]["rms_force"]
 
 
 def test_a_coupling_whose_trial_lost_against_the_bent_base_is_sized():
@@ -149,11 +152,10 @@ def test_a_coupling_whose_trial_lost_against_the_bent_base_is_sized():
     from its trial's frequency all the same."""
     truth = {"effect": "resonance", "frequency": 29.280573104767917,
              "damping_ratio": 0.06716422355279661, "load_fraction": 0.6048048514981181}
-    rec, hold, believed, _ = case([truth], seed=43084, axis_seed=8756, kind="p2p",
-                                  duration=6.0, rate_hz=1000.0,
-                                  current_noise=0.0040866957595806575, quantum=1e-07,
-                                  base_error=0.006073485933775821)
-    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    dg = _stress_chain([truth], seed=43084, axis_seed=8756, kind="p2p",
+                       duration=6.0, rate_hz=1000.0,
+                       current_noise=0.0040866957595806575, quantum=1e-07,
+                       base_error=0.006073485933775821)
     got = {f.effect: f.parameters for f in dg.findings}
     assert list(got) == ["resonance"], dg.summary()
     assert got["resonance"]["frequency"] == pytest.approx(29.28, rel=0.1)
@@ -169,11 +171,10 @@ def test_a_delay_in_a_base_fitted_near_its_floor_is_named():
     nothing was named (0.16 N held out where the true model with the delay reaches
     0.11 N). The stage also takes half the excess over the floor."""
     truth = {"effect": "delay", "seconds": 0.0013134481143544422}
-    rec, hold, believed, _ = case([truth], seed=43050, axis_seed=4545, kind="p2p",
-                                  duration=10.0, rate_hz=2000.0,
-                                  current_noise=0.005275814150924591, quantum=1e-06,
-                                  base_error=0.007570479097147127)
-    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    dg = _stress_chain([truth], seed=43050, axis_seed=4545, kind="p2p",
+                       duration=10.0, rate_hz=2000.0,
+                       current_noise=0.005275814150924591, quantum=1e-06,
+                       base_error=0.007570479097147127)
     got = {kind(f.effect): f.parameters for f in dg.findings}
     assert list(got) == [kind("delay")], dg.summary()
     assert got[kind("delay")]["seconds"] == pytest.approx(truth["seconds"], rel=0.15)
@@ -197,11 +198,10 @@ def test_an_absorbed_delay_is_named_on_its_own_test_beside_a_bump():
              {"effect": "position_friction",
               "positions": list(-0.10433235354639793 + 0.005625 * np.arange(25)),
               "scale": bump + bump[-2::-1]}]
-    rec, hold, believed, _ = case(truth, seed=42090, axis_seed=None, kind="sines",
-                                  duration=20.0, rate_hz=5000.0,
-                                  current_noise=0.004586628031802712, quantum=1e-07,
-                                  base_error=0.018972492282081626)
-    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    dg = _stress_chain(truth, seed=42090, axis_seed=None, kind="sines",
+                       duration=20.0, rate_hz=5000.0,
+                       current_noise=0.004586628031802712, quantum=1e-07,
+                       base_error=0.018972492282081626)
     got = {kind(f.effect): f for f in dg.findings}
     assert set(got) == {kind("delay"), "position_friction"}, dg.summary()
     assert got[kind("delay")].parameters["seconds"] == pytest.approx(1.124e-3, rel=0.15)
@@ -217,11 +217,10 @@ def test_a_deadband_sized_beside_a_stribeck_shape_starts_a_sound_search():
     named nothing. It now starts from the base polished beside the dead-band alone."""
     truth = [{"effect": "deadband", "current": 0.07616372799468052},
              {"effect": "stribeck_shape", "exponent": 0.9}]
-    rec, hold, believed, _ = case(truth, seed=42094, axis_seed=None, kind="sines",
-                                  duration=30.0, rate_hz=2000.0,
-                                  current_noise=0.016411177146353526, quantum=5e-06,
-                                  base_error=0.005241671559467986)
-    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    dg = _stress_chain(truth, seed=42094, axis_seed=None, kind="sines",
+                       duration=30.0, rate_hz=2000.0,
+                       current_noise=0.016411177146353526, quantum=5e-06,
+                       base_error=0.005241671559467986)
     got = {f.effect: f.parameters for f in dg.findings}
     assert set(got) == {"deadband", "stribeck_shape"}, dg.summary()
     assert got["deadband"]["current"] == pytest.approx(0.0762, rel=0.3)
@@ -241,11 +240,10 @@ def test_a_coupling_is_sized_beside_what_the_rest_resembled_when_alone_fails():
               "time_constant": 5.321246447606497},
              {"effect": "resonance", "frequency": 29.88797572186502,
               "damping_ratio": 0.07964110527421099, "load_fraction": 0.7263904713806387}]
-    rec, hold, believed, _ = case(truth, seed=44108, axis_seed=None, kind="sines",
-                                  duration=20.0, rate_hz=5000.0,
-                                  current_noise=0.0045235767750005556, quantum=1e-07,
-                                  base_error=0.018576034052507632)
-    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    dg = _stress_chain(truth, seed=44108, axis_seed=None, kind="sines",
+                       duration=20.0, rate_hz=5000.0,
+                       current_noise=0.0045235767750005556, quantum=1e-07,
+                       base_error=0.018576034052507632)
     got = {f.effect: f.parameters for f in dg.findings}
     assert set(got) == {"stribeck_shape", "drift", "resonance"}, dg.summary()
     assert got["resonance"]["frequency"] == pytest.approx(29.89, rel=0.15)
@@ -266,11 +264,10 @@ def test_a_drift_sized_beside_a_spring_is_searched_from_the_base_beside_both():
               "time_constant": 3.9545214138592537},
              {"effect": "spring", "stiffness": 18.61475389102747,
               "x0": 0.018607364231180062}]
-    rec, hold, believed, _ = case(truth, seed=45092, axis_seed=None, kind="sines",
-                                  duration=30.0, rate_hz=2000.0,
-                                  current_noise=0.011268035451713612, quantum=5e-06,
-                                  base_error=0.011389292740645074)
-    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    dg = _stress_chain(truth, seed=45092, axis_seed=None, kind="sines",
+                       duration=30.0, rate_hz=2000.0,
+                       current_noise=0.011268035451713612, quantum=5e-06,
+                       base_error=0.011389292740645074)
     got = {f.effect: f.parameters for f in dg.findings}
     assert set(got) == {"drift", "spring"}, dg.summary()
     assert got["drift"]["gain"] == pytest.approx(0.1095, rel=0.3)
@@ -350,8 +347,7 @@ def test_a_drag_beside_a_deadband_survives_the_joint_refit():
              "base_error": 0.019896702923822288}
     effects = [{"effect": "drag", "coefficient": 54.00109976350709},
                {"effect": "deadband", "current": 0.02833876845406429}]
-    rec, hold, believed, _ = case(effects, **setup)
-    dg = _chain(rec, believed.force_constant, believed.controller, hold)
+    dg = _stress_chain(effects, **setup)
     got = {f.effect: f.parameters for f in dg.findings}
     assert sorted(got) == ["deadband", "drag"], dg.summary()
     assert got["drag"]["coefficient"] == pytest.approx(54.0, rel=0.05)
