@@ -255,6 +255,20 @@ def test_diagnose_same_on_both_backends():
             assert pa[k] == pytest.approx(pb[k], rel=1e-8, abs=1e-12), k
 
 
+@pytest.mark.parametrize("case", ["plain", "load+shape+scales"])
+def test_sensitivities_in_two_halves_as_one_by_one(pair, case):
+    """The core carries the parameters in two halves on two threads: every column and
+    the force the same, bit for bit, as each parameter's own pass."""
+    sig, _, model = pair
+    m = with_effects(model, case)
+    force, jac, nonzero = sig.kernel.base_sensitivities(m, NAMES)
+    for j, name in enumerate(NAMES):
+        f1, j1, n1 = sig.kernel.base_sensitivities(m, [name])
+        np.testing.assert_array_equal(jac[:, j], j1[:, 0], err_msg=name)
+        np.testing.assert_array_equal(force, f1, err_msg=name)
+        assert nonzero[j] == n1[0]
+
+
 @pytest.mark.parametrize("backend", ["core", "reference"])
 def test_residuals_batch_as_one_by_one(pair, backend):
     sig = pair[0] if backend == "core" else pair[1]

@@ -346,28 +346,27 @@ impl Problem<'_> {
     }
 
     /// `(J^T W J, J^T W r)`, every product summed over the samples in their order in
-    /// one pass (the sums of one pass per product, with their rounding).
+    /// one pass (the sums of one pass per product, with their rounding); the rows in
+    /// two parts, each on its own thread (rayon), the same numbers.
     fn normal(j: &[Vec<f64>], w: &[f64], r: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
         let q = j.len();
         let n = j
             .iter()
             .map(Vec::len)
             .fold(w.len().min(r.len()), usize::min);
-        // (`-0.0`: the start of a float `Iterator::sum`)
-        let mut b = vec![-0.0f64; q];
-        let mut lower = vec![-0.0f64; q * (q + 1) / 2];
-        for t in 0..n {
-            let (wt, rt) = (w[t], r[t]);
-            let mut p = 0;
-            for i in 0..q {
-                let x = j[i][t];
-                b[i] += x * wt * rt;
-                for col in &j[..=i] {
-                    lower[p] += x * col[t] * wt;
-                    p += 1;
-                }
-            }
+        // rows 0..m hold about half of the products (row i: i + 2 of them)
+        let total = q * (q + 3) / 2;
+        let mut m = 0;
+        let mut acc = 0;
+        while m < q && 2 * (acc + m + 2) <= total {
+            acc += m + 2;
+            m += 1;
         }
+        let ((b0, l0), (b1, l1)) = rayon::join(
+            || Self::normal_rows(j, w, r, n, 0..m),
+            || Self::normal_rows(j, w, r, n, m..q),
+        );
+        let (b, lower) = ([b0, b1].concat(), [l0, l1].concat());
         let mut a = DMatrix::zeros(q, q);
         let mut p = 0;
         for i in 0..q {
@@ -378,6 +377,35 @@ impl Problem<'_> {
             }
         }
         (a, DVector::from_vec(b))
+    }
+
+    /// The sums of [`Problem::normal`] of the rows `rows` over the first `n` samples:
+    /// `J^T W r` and the lower triangle, row by row.
+    fn normal_rows(
+        j: &[Vec<f64>],
+        w: &[f64],
+        r: &[f64],
+        n: usize,
+        rows: std::ops::Range<usize>,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let first = rows.start * (rows.start + 1) / 2;
+        let last = rows.end * (rows.end + 1) / 2;
+        // (`-0.0`: the start of a float `Iterator::sum`)
+        let mut b = vec![-0.0f64; rows.len()];
+        let mut lower = vec![-0.0f64; last - first];
+        for t in 0..n {
+            let (wt, rt) = (w[t], r[t]);
+            let mut p = 0;
+            for (bi, i) in b.iter_mut().zip(rows.clone()) {
+                let x = j[i][t];
+                *bi += x * wt * rt;
+                for col in &j[..=i] {
+                    lower[p] += x * col[t] * wt;
+                    p += 1;
+                }
+            }
+        }
+        (b, lower)
     }
 
     fn run(&mut self, start: &Model, max_iter: usize) -> Result<Option<Run>> {
@@ -583,4 +611,34 @@ pub fn fit_base(
         evaluations: pb.evaluations,
         model: best.model,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Problem;
+
+    /// The normal equations, rows in two parts on two threads, against each product
+    /// summed on its own over the samples in their order: the same numbers.
+    #[test]
+    fn normal_in_two_parts_as_each_product_alone() {
+        let n = 1000;
+        let wave = |a: f64, k: usize| (a * k as f64).sin() + 0.1 * a;
+        for q in 1..8 {
+            let j: Vec<Vec<f64>> = (0..q)
+                .map(|c| (0..n).map(|k| wave(0.37 + c as f64, k)).collect())
+                .collect();
+            let w: Vec<f64> = (0..n).map(|k| 1.0 + wave(0.05, k).abs()).collect();
+            let r: Vec<f64> = (0..n).map(|k| wave(1.9, k)).collect();
+            let (a, b) = Problem::normal(&j, &w, &r);
+            for i in 0..q {
+                let bi: f64 = (0..n).map(|t| j[i][t] * w[t] * r[t]).sum();
+                assert_eq!(b[i].to_bits(), bi.to_bits());
+                for k in 0..=i {
+                    let s: f64 = (0..n).map(|t| j[i][t] * j[k][t] * w[t]).sum();
+                    assert_eq!(a[(i, k)].to_bits(), s.to_bits());
+                    assert_eq!(a[(k, i)].to_bits(), s.to_bits());
+                }
+            }
+        }
+    }
 }

@@ -119,8 +119,40 @@ impl Record {
     /// The LuGre force of [`Record::base_friction`] and its filtered derivatives with
     /// respect to `params`, propagated exactly through the bristle update. (A
     /// `load_friction` raises both levels by the same amount, which depends on none of
-    /// the parameters: the derivatives keep their form.)
+    /// the parameters: the derivatives keep their form.) The parameters go in two
+    /// halves, each carried along the record on its own thread (rayon); every column
+    /// is the same, number for number, as in one pass of all of them.
     pub fn base_sensitivities(&self, model: &Model, params: &[BaseParam]) -> Sensitivities {
+        let half = params.len().div_ceil(2);
+        let ((force, mut cols), (_, rest)) = if params.len() >= 2 {
+            rayon::join(
+                || self.sensitivity_pass(model, &params[..half], true),
+                || self.sensitivity_pass(model, &params[half..], false),
+            )
+        } else {
+            (
+                self.sensitivity_pass(model, params, true),
+                (Vec::new(), Vec::new()),
+            )
+        };
+        cols.extend(rest);
+        let nonzero = cols.iter().map(|c| c.iter().any(|&x| x != 0.0)).collect();
+        self.filt_in_place(&mut cols);
+        Sensitivities {
+            force,
+            columns: cols,
+            nonzero,
+        }
+    }
+
+    /// The unfiltered columns of `params` along the record, and the LuGre force when
+    /// `with_force` (else no force).
+    fn sensitivity_pass(
+        &self,
+        model: &Model,
+        params: &[BaseParam],
+        with_force: bool,
+    ) -> (Vec<f64>, Vec<Vec<f64>>) {
         let n = self.len();
         let q = params.len();
         let exponent = exponent_of(model);
@@ -133,7 +165,7 @@ impl Record {
         let lev = self.friction_level(model);
         let lh = lev.as_deref().map(midpoints);
         let vh = midpoints(&self.v);
-        let mut force = vec![0.0; n];
+        let mut force = vec![0.0; if with_force { n } else { 0 }];
         let mut cols = vec![vec![0.0; n]; q];
         let mut dz = vec![0.0; q];
         let mut z = 0.0;
@@ -145,7 +177,9 @@ impl Record {
             let set = p.set(v);
             let g = sc * g_loaded(set, v, lev.as_ref().map_or(0.0, |l| l[k]), exponent);
             let w = v - s0 * v.abs() * z / g;
-            force[k] = s0 * z + s1 * w + set.sigma2 * v;
+            if with_force {
+                force[k] = s0 * z + s1 * w + set.sigma2 * v;
+            }
             // (one exponential for every parameter of the set; unused without fc, fs, vs)
             let e = stribeck_e(set, v, ex);
             for (j, par) in params.iter().enumerate() {
@@ -181,12 +215,6 @@ impl Record {
             }
             z = p.advance_z(z, u, gh, self.dt);
         }
-        let nonzero = cols.iter().map(|c| c.iter().any(|&x| x != 0.0)).collect();
-        self.filt_in_place(&mut cols);
-        Sensitivities {
-            force,
-            columns: cols,
-            nonzero,
-        }
+        (force, cols)
     }
 }
