@@ -28,18 +28,19 @@ __all__ = ["assemble", "closed_loop"]
 
 
 def closed_loop(rec: Recording, before: Model, after: Model,
-                simulate: Any) -> dict[str, Any] | None:
+                simulate_batch: Any) -> dict[str, Any] | None:
     """Closed-loop simulations of both models under the recorded reference, against the
-    record (PID controllers only; None without one or without ``x_ref``)."""
+    record (PID controllers only; None without one or without ``x_ref``); the two run
+    side by side (``simulate_batch`` of a backend)."""
     c = before.controller
     if c is None or rec.x_ref is None or c.get("type", "pid") != "pid":
         return None
+    try:
+        sims = simulate_batch([before, after], rec.t, rec.x_ref, x0=float(rec.x[0]))
+    except (ValueError, ArithmeticError) as e:  # pragma: no cover - diverging
+        return {"error": str(e)}
     out = {}
-    for key, m in (("before", before), ("after", after)):
-        try:
-            s = simulate(m, rec.t, rec.x_ref, x0=float(rec.x[0]))
-        except (ValueError, ArithmeticError) as e:  # pragma: no cover - diverging
-            return {"error": str(e)}
+    for key, m, s in (("before", before, sims[0]), ("after", after, sims[1])):
         meas_i = rec.i if rec.i is not None else rec.F / m.force_constant
         out[key] = {"rms_position": float(np.sqrt(np.mean((s.x - rec.x) ** 2))),
                     "rms_current": float(np.sqrt(np.mean((s.i - meas_i) ** 2)))}
@@ -76,7 +77,7 @@ def _fit(prep: Prepared, w: Weighing, sel: Selection, ev: Evidence, opts: Option
         "with_findings": float(np.sqrt(sel.ev.sse_b.sum() / prep.n_used)),
     }
     if opts.closed_loop:
-        cl = closed_loop(prep.rec, prep.model_given, aug, sig.backend.simulate)
+        cl = closed_loop(prep.rec, prep.model_given, aug, sig.backend.simulate_batch)
         if cl is not None and "error" not in cl:
             fit["closed_loop"] = cl
     return fit
