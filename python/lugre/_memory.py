@@ -1,38 +1,43 @@
-"""Memory the allocator keeps after a long record's columns are freed.
+"""How many heaps the allocator keeps: at most one per core.
 
-A diagnosis of a long record builds and frees hundreds of columns of the record's
-length (8 MB each for a million samples). glibc serves them from its heap once the
-first is freed and keeps the freed pages resident, so the process's resident size
-climbs through the stages even where the bytes in use do not (on a million samples,
-about 100 MB over a call). :func:`trim` hands the free pages back between the stages
-and trials that free most, at the cost of a walk over the heap (a millisecond or so).
+The core runs its batches on a pool of threads (rayon), one per core. glibc gives each
+thread that allocates its own heap (arena), up to eight per core, and a heap keeps the
+pages of what was freed in it: on a long record, where every column is the record's
+length (8 MB for a million samples), each thread's heap holds its own freed columns
+and the process's resident size grows with the number of heaps, not with the bytes in
+use. One heap per core holds the diagnosis of a million samples at 1 kHz to about
+950 MiB where the default reached 1000 MiB, at no cost in time (docs/BENCHMARKS.md);
+freeing the pages after every stage (``malloc_trim``) came to less and cost a tenth of
+the time.
+
+Nothing is changed where the user set ``MALLOC_ARENA_MAX`` or the C library is not
+glibc.
 """
 
 from __future__ import annotations
 
 import ctypes
 import ctypes.util
-from typing import Any
+import os
 
-__all__ = ["trim"]
+__all__ = ["one_heap_per_core"]
+
+#: ``mallopt``'s parameter for the most arenas (glibc's ``M_ARENA_MAX``).
+_M_ARENA_MAX = -8
 
 
-def _libc_trim() -> Any:
+def one_heap_per_core() -> bool:
+    """Cap glibc's arenas at the number of cores; whether it was set."""
+    if "MALLOC_ARENA_MAX" in os.environ:
+        return False
     name = ctypes.util.find_library("c")
+    if not name:
+        return False
     try:
-        fn = ctypes.CDLL(name).malloc_trim if name else None
-    except (OSError, AttributeError):  # (not glibc: nothing to trim)
-        return None
-    if fn is not None:
-        fn.argtypes, fn.restype = [ctypes.c_size_t], ctypes.c_int
-    return fn
-
-
-_TRIM = _libc_trim()
-
-
-def trim() -> None:
-    """Return the allocator's free pages to the system (glibc's ``malloc_trim``; a
-    no-op elsewhere). The numbers computed are not touched."""
-    if _TRIM is not None:
-        _TRIM(0)
+        libc = ctypes.CDLL(name)
+        libc.gnu_get_libc_version  # noqa: B018  (glibc only)
+        mallopt = libc.mallopt
+    except (OSError, AttributeError):  # (not glibc: its own allocator)
+        return False
+    mallopt.argtypes, mallopt.restype = [ctypes.c_int, ctypes.c_int], ctypes.c_int
+    return bool(mallopt(_M_ARENA_MAX, max(os.cpu_count() or 1, 1)))

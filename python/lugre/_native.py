@@ -33,9 +33,12 @@ from ._core import position_sums as core_position_sums
 from ._core import simulate as core_simulate
 from ._core import simulate_batch as core_simulate_batch
 from ._core import stribeck as core_stribeck
+from ._memory import one_heap_per_core
 from ._result import CouplingResult, GridFit, LinearFit, SimResult
 from .exceptions import InputError, ParameterError
 from .model import ModelLike, _as_model
+
+one_heap_per_core()  # (before the core's threads first allocate)
 
 __all__ = ["InverseRecord", "filtfilt", "friction_force", "irls_linear", "irls_linear_grid", "load_coupling",
            "moving_median", "position_sums", "simulate", "simulate_batch", "stribeck"]

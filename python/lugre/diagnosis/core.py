@@ -11,7 +11,6 @@ import warnings
 from typing import Any
 
 from .. import units as U
-from .._memory import trim
 from ..exceptions import PassivityWarning
 from ..io import Recording
 from ..model import Model, _as_model
@@ -344,13 +343,10 @@ def _run(rec: Recording, model: Model, opts: Options) -> Diagnosis:
         w = weigh(prep, q.model, q.r0, opts)
         sel = select(prep, w, opts)
         release_columns(w.ctx)  # (hundreds of MB on a long record; read no more)
-        trim()
         j = refit(prep, w, sel, opts)
         later = _contradicted(prep, q, j, opts)
         if not later:
-            ev = gather(prep, w, sel, j, opts)
-            trim()
-            return assemble(prep, q, w, sel, ev, opts)
+            return assemble(prep, q, w, sel, gather(prep, w, sel, j, opts), opts)
         given, removed = prep.model_given, q.removed + tuple(e for _, e in later)
         model = without(q.model, {k for k, _ in later})
 

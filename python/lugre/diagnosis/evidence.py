@@ -11,7 +11,6 @@ from typing import Any
 import numpy as np
 
 from .. import units as U
-from .._memory import trim
 from ..model import Model
 from ..vocabulary import EFFECTS, is_timing
 from . import base as B
@@ -270,8 +269,6 @@ def could_not_reveal(scorer: Scorer, ctx: Any, cands: list[Any], found: list[str
             out.append(c.limit(ctx, partial(sizes, effect=c.effect, timing=c.timing)))
         except (ValueError, ArithmeticError, np.linalg.LinAlgError):  # pragma: no cover
             continue
-        finally:
-            trim()  # (the limit's columns freed)
     return [o for o in out if o is not None]
 
 

@@ -12,7 +12,6 @@ from typing import Any
 import numpy as np
 
 from .. import units as U
-from .._memory import trim
 from ..exceptions import DataError, LugreError, ParameterError
 from ..vocabulary import kind
 from .candidates import Candidate, Context, Term
@@ -178,8 +177,6 @@ def _try(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidate, ctx: 
         return _try_columns(scorer, terms, cur, c, ctx, rules, step)
     except (DataError, ParameterError):
         return None
-    finally:
-        trim()  # (a grid's transient columns freed: hundreds of MB on a long record)
 
 
 def _try_columns(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidate,
