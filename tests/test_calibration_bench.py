@@ -76,9 +76,9 @@ def test_a_light_inertia_is_named_not_the_load_friction_it_looks_like():
     believed inertia is 1.2 % light. The first search chose a current limit; a load
     friction fitted far better in its exact form and took its place, and stood: the
     inertia, which fits it as well (its block gains not told apart, t = 0.9), was never
-    compared. Now the kept story's own rivals are compared in turn, and where the two
-    are not told apart the correction of the axis is named, the load friction beside
-    it as its look-alike."""
+    compared. Now a kept story is compared in turn with a close rival that is the
+    axis's mass, and where the two are not told apart the mass is named, the load
+    friction beside it as its look-alike."""
     case = C.draw_case(33028, max_duration=15.0, min_duration=3.0)
     (rec, hold), = C.records([(case, [])])
     d = _diagnose(case, rec, hold, case["believed"])

@@ -176,8 +176,9 @@ def _lookalikes(prep: Prepared, w: Weighing, bs: BaseSet, cands: list[E.Candidat
     (a 200 Hz current lag logged at 10 kHz was named a dead-band by its linearised gain;
     exactly, the dead-band left 0.107 N, the timing 0.059 N), and where the other is a
     correction of the axis (:data:`BASE_LIKE`), that is named instead. A story kept in
-    place of another has its own close rivals compared in turn (a clean record's current
-    limit gave way to a load friction, which a 1.2 % light inertia told as well)."""
+    place of another is compared in turn with a close rival that is such a correction
+    (a clean record's current limit gave way to a load friction, which a 1.2 % light
+    inertia told as well)."""
     terms, ev, log = found
     run = _searcher(w, bs.scorer, opts)
     nested = {c.effect: set(c.supersedes) for c in cands}
@@ -214,7 +215,10 @@ def _lookalikes(prep: Prepared, w: Weighing, bs: BaseSet, cands: list[E.Candidat
                                  f"itself, fits as well (t = {tstat:.1f} over the blocks)")
         terms, ev, log = terms_b, ev_b, log + log_b
         out.add(eff)
-        pending = _close_rivals(log_b, terms, nested) + pending
+        # (only against a correction of the axis: chased further, a fitted base's
+        # record traded a dead-band for a delay, both wrong, beside a spring)
+        pending = [p for p in _close_rivals(log_b, terms, nested)
+                   if p[1] in BASE_LIKE] + pending
     return terms, ev, log, lookalike
 
 
