@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import units as U
 from ..vocabulary import EFFECTS, MASS, held_kinds, is_timing
 from . import base as B
 from . import candidates as E
@@ -150,10 +151,10 @@ def _lookalike_entry(eff: str, other: str, terms_b: list[Term], ev_b: Evaluation
     e_b = terms_b[kb].cand.to_effects(terms_b[kb].h, beta_b, ctx)[0]
     return {
         "effect": other, "parameters": {a: v for a, v in e_b.items() if a != "effect"},
-        "experiment": "; ".join(
+        "experiment": U.words("; ".join(
             f"for {'an' if e[0] in 'aeiou' else 'a'} {e.replace('_', ' ')}, "
             f"{EFFECTS[e].experiment if e in EFFECTS else 'a second record'}"
-            for e in (eff, other)),
+            for e in (eff, other))),
         "note": (f"fits {'slightly better' if dd.sum() > 0 else 'about as well'} in "
                  f"its exact form (difference {abs(dd.sum()):.0f} in squared-error "
                  f"units of the noise, t = {tstat:.1f} over the blocks): this record "
@@ -211,8 +212,9 @@ def _lookalikes(prep: Prepared, w: Weighing, bs: BaseSet, cands: list[E.Candidat
                                  "in squared-error units of the noise)")
         else:
             lookalike[other] = _lookalike_entry(other, eff, terms, ev, bs, w.ctx, -dd, tstat)
-            _not_named(log, eff, f"{other.replace('_', ' ')}, a correction of the axis "
-                                 f"itself, fits as well (t = {tstat:.1f} over the blocks)")
+            _not_named(log, eff, U.words(f"{other.replace('_', ' ')}, a correction of the "
+                                         f"axis itself, fits as well (t = {tstat:.1f} "
+                                         "over the blocks)"))
         terms, ev, log = terms_b, ev_b, log + log_b
         out.add(eff)
         # (only against a correction of the axis: chased further, a fitted base's
