@@ -5,10 +5,10 @@ thread that allocates its own heap (arena), up to eight per core, and a heap kee
 pages of what was freed in it: on a long record, where every column is the record's
 length (8 MB for a million samples), each thread's heap holds its own freed columns
 and the process's resident size grows with the number of heaps, not with the bytes in
-use. One heap per core holds the diagnosis of a million samples at 1 kHz to about
-950 MiB where the default reached 1000 MiB, at no cost in time (docs/BENCHMARKS.md);
-freeing the pages after every stage (``malloc_trim``) came to less and cost a tenth of
-the time.
+use. One heap per core holds the diagnosis of a million samples at 1 kHz to 948 MiB
+where the default reached 1023 MiB, at no cost in time (docs/BENCHMARKS.md); freeing
+the pages after every stage, trial and limit (``malloc_trim``) came to 943 MiB and cost
+1.4 s a call.
 
 Nothing is changed where the user set ``MALLOC_ARENA_MAX`` or the C library is not
 glibc.
@@ -17,7 +17,6 @@ glibc.
 from __future__ import annotations
 
 import ctypes
-import ctypes.util
 import os
 
 __all__ = ["one_heap_per_core"]
@@ -30,11 +29,10 @@ def one_heap_per_core() -> bool:
     """Cap glibc's arenas at the number of cores; whether it was set."""
     if "MALLOC_ARENA_MAX" in os.environ:
         return False
-    name = ctypes.util.find_library("c")
-    if not name:
-        return False
     try:
-        libc = ctypes.CDLL(name)
+        # (the process's own symbols: no search for the library, which can run
+        # ldconfig in a subprocess on every import)
+        libc = ctypes.CDLL(None)
         libc.gnu_get_libc_version  # noqa: B018  (glibc only)
         mallopt = libc.mallopt
     except (OSError, AttributeError):  # (not glibc: its own allocator)
