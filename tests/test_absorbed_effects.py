@@ -276,6 +276,34 @@ def test_a_drift_sized_beside_a_spring_is_searched_from_the_base_beside_both():
     assert after < 0.15 * before, dg.fit
 
 
+def test_a_delay_beside_a_coupling_that_took_its_phase_is_named():
+    """Stress seed 26, case 049: a 1.18 ms delay beside a 19.2 Hz coupling (damping
+    0.067), 20 s of sines at 5 kHz, fitted with the mass given. Against the fit the
+    coupling was found first and profiled alone: it read the delay's phase as damping
+    (0.18), and the delay then added too little beside it to be named (a gain of 13
+    that passed the block test, held back by the noise floor). Only the coupling was
+    named (0.35 N held out; the near-true model with both 0.17 N). A term held back by
+    the noise floor alone is tried again beside the coupling profiled anew with it."""
+    truth = [{"effect": "delay", "seconds": 0.0011821118081391507},
+             {"effect": "resonance", "frequency": 19.19632728860017,
+              "damping_ratio": 0.06702574028857947, "load_fraction": 0.7047011340470077}]
+    rec, hold, believed, _ = case(truth, seed=46098, axis_seed=1484, kind="sines",
+                                  duration=20.0, rate_hz=5000.0,
+                                  current_noise=0.012903275137765922, quantum=5e-06,
+                                  base_error=0.007447486581329662)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted, _ = fit_model(rec, force_constant=believed.force_constant,
+                              mass=believed.mass)
+        dg = diagnose(rec, fitted.replace(controller=believed.controller), holdout=hold)
+    got = {kind(f.effect): f.parameters for f in dg.findings}
+    assert set(got) == {kind("delay"), "resonance"}, dg.summary()
+    assert got["resonance"]["frequency"] == pytest.approx(19.2, rel=0.05)
+    assert any("profiled again with it" in t["why"] for t in dg.trials), dg.summary()
+    before, after = _held_out(dg)
+    assert after < 0.35 * before, dg.fit
+
+
 def test_a_coupling_that_only_filters_the_current_noise_is_not_absorbed():
     """Stress seed 24, case 040: a drag, and a fit at 1.1 times its noise floor. Sized
     beside the fitted base, a 29.6 Hz coupling took the residual from 0.289 to 0.193 N
