@@ -125,8 +125,9 @@ def test_a_coupling_beside_a_spring_is_sized_with_the_spring_held():
     first search's spring left most of the rest unexplained (not named), and the
     coupling sized alone left 1.42 N: nothing was named (held out 2.24 -> 1.84 N). Held
     beside the spring the rest resembled, the coupling is sized at its frequency and
-    the second search names both. (A small load friction beside them, 1.6 % on the
-    confined route, is the case's known wrong extra: DIAGNOSIS.md, session 21.)"""
+    the second search names both. A small load friction beside them (1.6 % on the
+    confined route, named until session 24) stood in for the base: refitted without
+    it, the base fits the record as well, and the search from there names the two."""
     truth = [{"effect": "resonance", "frequency": 18.032018277729065,
               "damping_ratio": 0.03815249875876202, "load_fraction": 0.6922564295725715},
              {"effect": "spring", "stiffness": 22.801514036427417,
@@ -136,10 +137,10 @@ def test_a_coupling_beside_a_spring_is_sized_with_the_spring_held():
                        current_noise=0.038699352962639454, quantum=1e-07,
                        base_error=0.015758705404010483)
     got = {f.effect: f.parameters for f in dg.findings}
-    assert {"resonance", "spring"} <= set(got), dg.summary()
+    assert set(got) == {"resonance", "spring"}, dg.summary()
     assert got["resonance"]["frequency"] == pytest.approx(18.03, rel=0.05)
     assert got["spring"]["stiffness"] == pytest.approx(22.80, rel=0.05)
-    assert dg.rebased and "beside it and spring" in dg.rebased["text"], dg.rebased
+    assert dg.rebased and "other than load_friction" in dg.rebased["text"], dg.rebased
     before, after = _held_out(dg)
     assert after < 0.2 * before, dg.fit
 
@@ -302,6 +303,30 @@ def test_a_delay_beside_a_coupling_that_took_its_phase_is_named():
     assert any("profiled again with it" in t["why"] for t in dg.trials), dg.summary()
     before, after = _held_out(dg)
     assert after < 0.35 * before, dg.fit
+
+
+def test_a_deadband_that_stands_in_for_the_fitted_base_is_not_named():
+    """Stress seed 27, case 035: a warm-up drift on a 10 s feed record, fitted with the
+    mass given. The fit bent its humps to the drift; the search named the drift and,
+    from the bent base, a 7 mA dead-band beside it (the near-true model names the
+    drift alone). Refitted with the drift in and the dead-band left out, the base fits
+    the record about as well; the search from there names the drift alone and leaves no
+    more on the held-out record."""
+    truth = [{"effect": "drift", "gain": 0.11431690023846773,
+              "time_constant": 3.207970161373143}]
+    rec, hold, believed, _ = case(truth, seed=47070, axis_seed=8175, kind="feeds",
+                                  duration=10.0, rate_hz=2000.0,
+                                  current_noise=0.01779884188565775, quantum=5e-06,
+                                  base_error=0.006363450768474049)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted, _ = fit_model(rec, force_constant=believed.force_constant,
+                              mass=believed.mass)
+        dg = diagnose(rec, fitted.replace(controller=believed.controller), holdout=hold)
+    assert [f.effect for f in dg.findings] == ["drift"], dg.summary()
+    assert any("stood in for the base" in n for n in dg.notes), dg.notes
+    before, after = _held_out(dg)
+    assert after < 0.5 * before, dg.fit
 
 
 def test_a_coupling_that_only_filters_the_current_noise_is_not_absorbed():

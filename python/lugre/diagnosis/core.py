@@ -32,7 +32,7 @@ from .options import (
 )
 from .prepare import Prepared, prepare
 from .question import Questioned, contradicted_beside, question, without
-from .rebase import far_base
+from .rebase import STAND_IN, far_base
 from .report import Diagnosis
 from .samerecord import fitted_on_this_record, say_fitted_here
 from .search import ATTESTED_WHY, release_columns
@@ -136,6 +136,8 @@ def diagnose(
             free_mass=free_mass)
         if far is not None:
             dg = _kept(_from_refitted_base(rec, model, dg, far, opts), dg)
+        if fitted and candidates is None:
+            dg = _stand_ins(rec, model, dg, opts)
     if "mass" in fitted:
         with U.axis(model.kind):
             dg = name_mass_change(dg, model, rec, cutoff_hz=cutoff_hz, backend=backend)
@@ -175,6 +177,60 @@ def _far(rec: Recording, model: Model, dg: Diagnosis, fitted: bool,
     return far_base(rec, model, dg.augmented.replace(
         effects=list(dg.augmented.effects) + held), held="the effects it resembles",
         rms_before=float((dg.unexplained or {})["rms_force"]), **kw)
+
+
+def _stand_ins(rec: Recording, model: Model, dg: Diagnosis, opts: Options) -> Diagnosis:
+    """A finding that stands in for the fitted base beside the others, dropped.
+
+    A base that ``lugre fit`` bent to an effect it did not hold (a spring's force on a
+    sine record taken into a zero sigma1 and a higher hump) stays bent while the search
+    names the effect; what the bend leaves at the reversals is then named too (a
+    dead-band of 26 mA beside a 30 N/m spring, stress seed 27, case 034). The base is
+    refitted with each finding left out and the others in; where it then fits the
+    record about as well as with the finding (:func:`far_base` with ``against``), the
+    search runs again from there, and its result is taken when it no longer names that
+    finding and leaves about as little on the held-out record (:func:`_as_well`)."""
+    if len(dg.findings) < 2:
+        return dg
+    own = {kind(e["effect"]) for e in model.to_dict().get("effects") or []}
+    for f in dg.findings:
+        k = kind(f.effect)
+        if k in own:
+            continue
+        effects = [e for e in dg.augmented.effects if kind(e["effect"]) != k]
+        if len(effects) == len(dg.augmented.effects):
+            continue  # (a mass change: the base's own)
+        # (it must do about as well as the model with the finding: whether the base
+        # moves beyond its tolerances does not matter)
+        far = far_base(rec, model, dg.augmented.replace(effects=effects),
+                       cutoff_hz=opts.cutoff_hz, backend=opts.backend,
+                       free_mass=opts.free_mass, held=f"the findings other than {f.effect}",
+                       against=dg.augmented)
+        if far is None:
+            continue
+        again = _from_refitted_base(rec, model, dg, far, opts)
+        if k in {kind(g.effect) for g in again.findings} or not _as_well(again, dg):
+            continue
+        again.notes.append(
+            f"The first search named {f.effect} beside the rest, from the base as fitted; "
+            f"refitted with the rest in but {f.effect} left out, the base alone fits this "
+            f"record about as well ({far['rms_refit']:.3g} {U.si('N')} rms, against "
+            f"{far['rms_given']:.3g} {U.si('N')} with it), and the search from there does not "
+            f"name {f.effect} and does about as well on the held-out record: it stood in for "
+            "the base.")
+        return again
+    return dg
+
+
+def _as_well(again: Diagnosis, first: Diagnosis) -> bool:
+    """Whether ``again`` leaves at most :data:`STAND_IN` more than ``first``: on the
+    held-out record when there is one, else on the record itself (a dead-band of 1.9 mA
+    beside a drag and a friction bump, stress seed 27, case 047: 0.0819 N held out
+    without it, 0.0791 N with it)."""
+    a, b = _held_out_rms(again), _held_out_rms(first)
+    if not (a > 0.0 and b > 0.0):
+        a, b = _held_out_rms(again, "after"), _held_out_rms(first, "after")
+    return a <= (1.0 + STAND_IN) * b
 
 
 def _from_refitted_base(rec: Recording, model: Model, first: Diagnosis, far: dict[str, Any],

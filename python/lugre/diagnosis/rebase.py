@@ -16,12 +16,16 @@ from . import residual as R
 from .base import BASE_PARAMS, apply_base, get_base
 from .basefit import _run, _value, base_names, fit_base
 
-__all__ = ["REBASE_GAIN", "REBASE_TOLERANCES", "far_base"]
+__all__ = ["REBASE_GAIN", "REBASE_TOLERANCES", "STAND_IN", "far_base"]
 
 #: Least share of the residual's rms the refit must remove ...
 REBASE_GAIN = 0.2
 #: ... while moving a base parameter by more than this many of its tolerances.
 REBASE_TOLERANCES = 3.0
+
+#: A base refitted without a finding that comes within this share of the residual with
+#: it may have had it stand in for the base (the search from there decides).
+STAND_IN = 0.05
 
 _TOL = dict(BASE_PARAMS)
 
@@ -36,7 +40,8 @@ def _rms(r: np.ndarray, mask: np.ndarray) -> float:
 
 def far_base(rec: Any, given: Model, augmented: Model, *, cutoff_hz: float | None,
              backend: Any, free_mass: bool, held: str = "the findings",
-             rms_before: float | None = None) -> dict[str, Any] | None:
+             rms_before: float | None = None, against: Model | None = None
+             ) -> dict[str, Any] | None:
     """Whether the given base is far from what the record supports.
 
     Returns None, or ``model`` (the given model, its own effects kept, with the base
@@ -44,19 +49,23 @@ def far_base(rec: Any, given: Model, augmented: Model, *, cutoff_hz: float | Non
     ``name``, ``given``, ``refit``, ``change``), ``rms_given`` and ``rms_refit`` [N]
     (the augmented model's residual before and after the quick refit) and ``text``.
     ``rms_before`` [N], when given, is the residual the refit must beat instead of the
-    augmented model's; ``held`` says in words what the refit held in.
+    augmented model's; ``held`` says in words what the refit held in. With ``against``
+    (a model with more effects than ``augmented``), the refit must come within
+    :data:`STAND_IN` of that model's residual, and need not move a parameter beyond its
+    tolerances: the finding it lacks may have stood in for the base (the search from the
+    refitted base decides, :func:`lugre.diagnosis.core.diagnose`).
     """
     sig = R.prepare(rec, augmented, cutoff_hz=cutoff_hz, backend=backend)
     names = base_names(free_mass)
     quick, _ = _run(sig, [augmented], names, keep=1, max_iter=30)
     r1 = np.asarray(sig.kernel.residual(quick))
     rms1 = _rms(r1, sig.mask)
-    rms0 = (_rms(np.asarray(sig.kernel.residual(augmented)), sig.mask)
+    rms0 = (_rms(np.asarray(sig.kernel.residual(against or augmented)), sig.mask)
             if rms_before is None else rms_before)
-    if not rms1 < (1.0 - REBASE_GAIN) * rms0:
+    if not rms1 < (1.0 + STAND_IN if against is not None else 1.0 - REBASE_GAIN) * rms0:
         return None
     moved = _moves(given, quick, names)
-    if not moved:
+    if not moved and against is None:
         return None
     # the base fitted from the grid with the findings held in it (without them the
     # effects pull it astray: a cogging on the slow samples doubles a hump), then put
@@ -64,12 +73,15 @@ def far_base(rec: Any, given: Model, augmented: Model, *, cutoff_hz: float | Non
     full = fit_base(sig, augmented, free_mass=free_mass, extra=[quick], profiles=False)
     refit = apply_base(given, {n: get_base(full.model, n) for n, _ in BASE_PARAMS})
     moves = _moves(given, refit, names) or moved
-    text = ("the base as given is far from what this record supports: "
-            + ", ".join(_move_words(m) for m in moves)
-            + f"; refitted with {held} in, the {U.force_words()} residual falls from "
-            f"{rms0:.3g} to {rms1:.3g} {U.si('N')} rms. The search was run again from the "
-            "refitted base, so "
-            "that no finding stands in for a base parameter")
+    where = ("the base as given is far from what this record supports: "
+             + ", ".join(_move_words(m) for m in moves)) if moves else (
+        "the base as given is not where this record puts it")
+    n = U.si("N")
+    fall = (f"falls from {rms0:.3g} to {rms1:.3g} {n} rms" if against is None else
+            f"is {rms1:.3g} {n} rms, against {rms0:.3g} {n} with that finding in as well")
+    text = (where + f"; refitted with {held} in, the {U.force_words()} residual {fall}. "
+            "The search was run again from the refitted base, so that no finding stands "
+            "in for a base parameter")
     return {"model": refit, "moves": moves, "rms_given": rms0, "rms_refit": rms1,
             "text": text}
 
