@@ -39,7 +39,7 @@ from ..model import Model
 from . import residual as R
 from .scoring import accept, block_evidence
 
-__all__ = ["NOISE_SHARE", "SURROGATE_SEED", "gains", "noise_made", "surrogates"]
+__all__ = ["NOISE_SHARE", "SIMEX_MARK", "SURROGATE_SEED", "gains", "noise_made", "surrogates"]
 
 #: Seed of the surrogate noise (a diagnosis gives the same answer every time).
 SURROGATE_SEED = 20_240_611
@@ -50,6 +50,10 @@ SURROGATE_SEED = 20_240_611
 #: on clean records logged at 2-5 kHz: 0.60-0.65 (session 9: the linear extrapolation
 #: left 35-40 % of their gain standing, enough to pass).
 NOISE_SHARE = 0.5
+
+#: What every reason this check gives for dropping a term says (the search's log keeps
+#: it, and later stages read it there).
+SIMEX_MARK = "(SIMEX)"
 
 
 def surrogates(rec: Recording, model: Model, sig: R.Signals
@@ -139,11 +143,11 @@ def noise_made(sig: R.Signals, sur: list[R.Signals], model: Model, fit: tuple[An
         if not passes(g0[j] - noise):
             out[k] = (f"its gain ({g0[j].sum():.0f} in squared-error units of the noise) is "
                       f"what the readings' own noise makes: noise like the record's added "
-                      f"to them raises it by {noise.sum():.0f} (SIMEX)")
+                      f"to them raises it by {noise.sum():.0f} {SIMEX_MARK}")
         elif noise.sum() > NOISE_SHARE * g0[j].sum():
             out[k] = (f"noise like the record's added to its readings raises its gain "
                       f"({g0[j].sum():.0f} in squared-error units of the noise) by "
-                      f"{noise.sum():.0f} (SIMEX): most of it is the readings' own noise, "
+                      f"{noise.sum():.0f} {SIMEX_MARK}: most of it is the readings' own noise, "
                       "and what would remain rests on how well the added noise copies the "
                       "record's")
     return out
