@@ -57,6 +57,16 @@ def _stress_chain(effects: list[dict], **setup: object) -> object:
     return _chain(rec, believed.force_constant, believed.controller, hold)
 
 
+def _chain_mass_given(effects: list[dict], **setup: object) -> object:
+    """A stress case through the chain with the mass given (issue 24's protocol)."""
+    rec, hold, believed, _ = case(effects, **setup)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted, _ = fit_model(rec, force_constant=believed.force_constant,
+                              mass=believed.mass)
+        return diagnose(rec, fitted.replace(controller=believed.controller), holdout=hold)
+
+
 def _held_out(dg: object) -> tuple[float, float]:
     return dg.fit["holdout_before"]["rms_force"], dg.fit["holdout_after"]["rms_force"]
 
@@ -288,15 +298,10 @@ def test_a_delay_beside_a_coupling_that_took_its_phase_is_named():
     truth = [{"effect": "delay", "seconds": 0.0011821118081391507},
              {"effect": "resonance", "frequency": 19.19632728860017,
               "damping_ratio": 0.06702574028857947, "load_fraction": 0.7047011340470077}]
-    rec, hold, believed, _ = case(truth, seed=46098, axis_seed=1484, kind="sines",
-                                  duration=20.0, rate_hz=5000.0,
-                                  current_noise=0.012903275137765922, quantum=5e-06,
-                                  base_error=0.007447486581329662)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        fitted, _ = fit_model(rec, force_constant=believed.force_constant,
-                              mass=believed.mass)
-        dg = diagnose(rec, fitted.replace(controller=believed.controller), holdout=hold)
+    dg = _chain_mass_given(truth, seed=46098, axis_seed=1484, kind="sines",
+                           duration=20.0, rate_hz=5000.0,
+                           current_noise=0.012903275137765922, quantum=5e-06,
+                           base_error=0.007447486581329662)
     got = {kind(f.effect): f.parameters for f in dg.findings}
     assert set(got) == {kind("delay"), "resonance"}, dg.summary()
     assert got["resonance"]["frequency"] == pytest.approx(19.2, rel=0.05)
@@ -314,15 +319,10 @@ def test_a_deadband_that_stands_in_for_the_fitted_base_is_not_named():
     more on the held-out record."""
     truth = [{"effect": "drift", "gain": 0.11431690023846773,
               "time_constant": 3.207970161373143}]
-    rec, hold, believed, _ = case(truth, seed=47070, axis_seed=8175, kind="feeds",
-                                  duration=10.0, rate_hz=2000.0,
-                                  current_noise=0.01779884188565775, quantum=5e-06,
-                                  base_error=0.006363450768474049)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        fitted, _ = fit_model(rec, force_constant=believed.force_constant,
-                              mass=believed.mass)
-        dg = diagnose(rec, fitted.replace(controller=believed.controller), holdout=hold)
+    dg = _chain_mass_given(truth, seed=47070, axis_seed=8175, kind="feeds",
+                           duration=10.0, rate_hz=2000.0,
+                           current_noise=0.01779884188565775, quantum=5e-06,
+                           base_error=0.006363450768474049)
     assert [f.effect for f in dg.findings] == ["drift"], dg.summary()
     assert any("stood in for the base" in n for n in dg.notes), dg.notes
     before, after = _held_out(dg)
@@ -335,15 +335,10 @@ def test_a_coupling_the_first_pass_dropped_as_noise_is_not_taken_for_absorbed():
     the record's added raised its gain by more than half (SIMEX). The stage for effects
     a fitted base absorbed then sized the coupling beside a refitted base and named it
     (64 Hz). An effect the first pass dropped as the readings' noise was not absorbed."""
-    rec, hold, believed, _ = case([], seed=48006, axis_seed=7867, kind="sines",
-                                  duration=30.0, rate_hz=5000.0,
-                                  current_noise=0.004132995666346363, quantum=1e-07,
-                                  base_error=0.014202946071288285)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        fitted, _ = fit_model(rec, force_constant=believed.force_constant,
-                              mass=believed.mass)
-        dg = diagnose(rec, fitted.replace(controller=believed.controller), holdout=hold)
+    dg = _chain_mass_given([], seed=48006, axis_seed=7867, kind="sines",
+                           duration=30.0, rate_hz=5000.0,
+                           current_noise=0.004132995666346363, quantum=1e-07,
+                           base_error=0.014202946071288285)
     assert dg.findings == [], dg.summary()
     assert any("SIMEX" in t["why"] and t["effect"] == "resonance" for t in dg.trials)
 

@@ -228,10 +228,17 @@ def _as_well(again: Diagnosis, first: Diagnosis) -> bool:
     held-out record when there is one, else on the record itself (a dead-band of 1.9 mA
     beside a drag and a friction bump, stress seed 27, case 047: 0.0819 N held out
     without it, 0.0791 N with it)."""
-    a, b = _held_out_rms(again), _held_out_rms(first)
-    if not (a > 0.0 and b > 0.0):
-        a, b = _held_out_rms(again, "after"), _held_out_rms(first, "after")
+    a, b, _ = _rests(again, first)
     return a <= (1.0 + STAND_IN) * b
+
+
+def _rests(again: Diagnosis, first: Diagnosis) -> tuple[float, float, str]:
+    """What two diagnoses leave [N rms] and where: on the held-out record when both
+    have one, else on the record itself."""
+    a, b = _held_out_rms(again), _held_out_rms(first)
+    if a > 0.0 and b > 0.0:
+        return a, b, "the held-out record"
+    return _held_out_rms(again, "after"), _held_out_rms(first, "after"), "this record"
 
 
 def _from_refitted_base(rec: Recording, model: Model, first: Diagnosis, far: dict[str, Any],
@@ -329,11 +336,7 @@ def _kept(again: Diagnosis, first: Diagnosis) -> Diagnosis:
     lost = {kind(f.effect) for f in first.findings} - {kind(f.effect) for f in again.findings}
     if not lost:
         return again
-    a, b = _held_out_rms(again), _held_out_rms(first)
-    where = "the held-out record"
-    if not (a > 0.0 and b > 0.0):
-        a, b, where = _held_out_rms(again, "after"), _held_out_rms(first, "after"), \
-            "this record"
+    a, b, where = _rests(again, first)
     if a <= b:
         return again
     n = U.si("N")

@@ -168,6 +168,11 @@ class _Trial:
     small: bool = False  # passed every rule but the noise floor's (NOISE_FLOOR_WHY)
 
 
+#: Why a term that passed every other rule is held back by the noise floor (such a term
+#: gets :func:`_second_look`).
+NOISE_FLOOR_WHY = "contribution small against the noise floor"
+
+
 def _try(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidate, ctx: Context,
          rules: _Rules, step: int) -> _Trial | None:
     """Candidate ``c`` beside ``terms``, judged by the rules; None when the record
@@ -241,9 +246,6 @@ def _try_columns(scorer: Scorer, terms: list[Term], cur: Evaluation, c: Candidat
              "accepted": False, "ok": ok, "why": why}
     return _Trial(cand=c, term=term, trial=trial, ev=ev, entry=entry, ok=ok, minor=minor,
                   bad=bad, small=small and not minor)
-
-
-NOISE_FLOOR_WHY = "contribution small against the noise floor"
 
 
 def _second_look(scorer: Scorer, terms: list[Term], cur: Evaluation, small: list[_Trial],
