@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from lugre.diagnosis import evaluate
 from lugre.diagnosis import residual as R
+from lugre.diagnosis.base import apply_base
 from lugre.diagnosis.basefit import base_names, identify, starts
 from lugre.diagnosis.inverse import fit_inverse_dynamics
 
@@ -167,6 +168,37 @@ def test_core_and_twin_agree(records):
     assert a["cost"] == pytest.approx(b["cost"], rel=1e-7)
 
 
+def test_a_start_at_its_optimum_is_not_followed_again_and_the_twin_agrees(records):
+    """A scout that converged is kept as it is (two iterations from the optimum, not
+    two more from where it stopped); a looser ``tol`` and no information give the same
+    on the core and on the twin, the information None."""
+    from lugre import reference
+
+    rec = records[0].slice((0.0, 1.5))
+    start = fit_inverse_dynamics(rec, force_constant=20.0, sliding=0.05)
+    names = base_names(True)
+    out = {}
+    for be, kernels in (("core", "core"), ("reference", reference.kernels)):
+        sig = R.prepare(rec, start, backend=kernels)
+        mask = [bool(b) for b in sig.mask]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            best = start
+            for _ in range(2):  # (this record's optimum is reached slowly)
+                first = sig.kernel.fit_base([best], mask, names, max_iter=300, keep=1)
+                best = apply_base(start, first["values"])
+            again = sig.kernel.fit_base([best], mask, names, keep=1, tol=1e-4,
+                                        information=False)
+        assert first["information"].shape == (len(names), len(names))
+        assert again["information"] is None
+        # (two iterations each under tol; followed again, two more)
+        assert again["iterations"] == 2, be
+        out[be] = again
+    a, b = out["core"], out["reference"]
+    for k, v in a["values"].items():
+        assert v == pytest.approx(b["values"][k], rel=1e-7, abs=1e-9), k
+
+
 def test_fit_base_refuses_bad_arguments(records):
     rec = records[0].slice((0.0, 1.0))
     start = fit_inverse_dynamics(rec, force_constant=20.0)
@@ -180,6 +212,9 @@ def test_fit_base_refuses_bad_arguments(records):
         sig.kernel.fit_base([], mask, ["mass"])
     with pytest.raises(ValueError, match="weighting"):
         sig.kernel.fit_base([start], mask, ["mass"], weighting="bogus")
+    for tol in (-1.0, float("nan")):
+        with pytest.raises(ValueError, match="tol"):
+            sig.kernel.fit_base([start], mask, ["mass"], tol=tol)
 
 
 def test_fit_with_effects_refits_the_base_with_them():

@@ -288,9 +288,11 @@ impl PyInverseRecord {
     /// The base parameters `names` fitted from `starts` by IGG-weighted
     /// Levenberg-Marquardt on the residual at the `mask`ed samples (see
     /// `lugre::inverse::fit_base`). A dict: `values` (every base parameter of the best
-    /// model by path), `cost`, `scale`, `criterion`, `weights`, `information` (`q x q`),
-    /// `start`, `iterations`, `evaluations`.
-    #[pyo3(signature = (starts, mask, names, max_iter=60, keep=3, scouts=12, weighting="huber"))]
+    /// model by path), `cost`, `scale`, `criterion`, `weights`, `information` (`q x q`;
+    /// None unless `information`), `start`, `iterations`, `evaluations`. A start stops
+    /// when the weighted sum of squares falls by less than `tol` (relative) twice in a row.
+    #[pyo3(signature = (starts, mask, names, max_iter=60, keep=3, scouts=12, weighting="huber",
+                        tol=1e-6, information=true))]
     #[allow(clippy::too_many_arguments)]
     fn fit_base<'py>(
         &self,
@@ -302,7 +304,13 @@ impl PyInverseRecord {
         keep: usize,
         scouts: usize,
         weighting: &str,
+        tol: f64,
+        information: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
+        if !(tol.is_finite() && tol >= 0.0) {
+            let why = format!("must be a finite number >= 0, got {tol}");
+            return Err(to_py(py, Error::input("tol", why)));
+        }
         let ms = starts
             .iter()
             .map(|m| model_of(py, m).map(|m| (*m).clone()))
@@ -312,6 +320,8 @@ impl PyInverseRecord {
             keep,
             scouts,
             weighting: Weighting::from_name(weighting).map_err(|e| to_py(py, e))?,
+            tol,
+            information,
             ..BaseFitOptions::default()
         };
         let fit = py
@@ -334,15 +344,19 @@ impl PyInverseRecord {
         values.set_item("sigma0", f.sigma0)?;
         values.set_item("sigma1", f.sigma1)?;
         let q = names.len();
-        let info =
-            Array2::from_shape_vec((q, q), fit.information.clone()).expect("q x q information");
         let out = PyDict::new(py);
         out.set_item("values", values)?;
         out.set_item("cost", fit.cost)?;
         out.set_item("scale", fit.scale)?;
         out.set_item("criterion", fit.criterion)?;
         out.set_item("weights", fit.weights.into_pyarray(py))?;
-        out.set_item("information", info.into_pyarray(py))?;
+        if information {
+            let info =
+                Array2::from_shape_vec((q, q), fit.information.clone()).expect("q x q information");
+            out.set_item("information", info.into_pyarray(py))?;
+        } else {
+            out.set_item("information", py.None())?;
+        }
         out.set_item("start", fit.start)?;
         out.set_item("iterations", fit.iterations)?;
         out.set_item("evaluations", fit.evaluations)?;

@@ -148,6 +148,8 @@ pub struct BaseFitOptions {
     /// Weights of the residuals (Huber by default: a structured misfit such as the
     /// sticking phases is down-weighted, never rejected).
     pub weighting: Weighting,
+    /// Work out [`BaseFit::information`] (one sensitivity pass more); else it is empty.
+    pub information: bool,
 }
 
 impl Default for BaseFitOptions {
@@ -159,6 +161,7 @@ impl Default for BaseFitOptions {
             keep: 3,
             tol: 1e-6,
             weighting: Weighting::huber(),
+            information: true,
         }
     }
 }
@@ -179,7 +182,8 @@ pub struct BaseFit {
     pub criterion: f64,
     /// Weights of the samples (0 outside the mask and for rejected ones).
     pub weights: Vec<f64>,
-    /// `J^T W J` in the parameters themselves (not their logs), row-major, `q x q`.
+    /// `J^T W J` in the parameters themselves (not their logs), row-major, `q x q`
+    /// (empty unless [`BaseFitOptions::information`]).
     pub information: Vec<f64>,
     /// Index of the start it came from.
     pub start: usize,
@@ -221,6 +225,8 @@ struct Run {
     cost: f64,
     scale: f64,
     iterations: usize,
+    /// It stopped because it converged (not at its iteration limit or a refused step).
+    converged: bool,
 }
 
 struct Problem<'a> {
@@ -408,6 +414,24 @@ impl Problem<'_> {
         (b, lower)
     }
 
+    /// `J^T W J` of a run's model in the parameters themselves (not their logs),
+    /// row-major.
+    fn information(&self, run: &Run) -> Vec<f64> {
+        let u = self.encode(&run.model);
+        let j = self.jacobian(&run.model, &u);
+        let jt: Vec<Vec<f64>> = j
+            .iter()
+            .zip(&u)
+            .zip(&self.scales)
+            .map(|((c, ui), sc)| {
+                let d = self.slope(*sc, *ui);
+                c.iter().map(|x| x / d).collect()
+            })
+            .collect();
+        let (a, _) = Self::normal(&jt, &run.w, &run.r);
+        a.transpose().as_slice().to_vec()
+    }
+
     fn run(&mut self, start: &Model, max_iter: usize) -> Result<Option<Run>> {
         let Some(mut r) = self.residual(start)? else {
             return Ok(None);
@@ -418,6 +442,7 @@ impl Problem<'_> {
         let mut lam = 1e-3;
         let mut iterations = 0;
         let mut small = 0;
+        let mut converged = false;
         for _ in 0..max_iter {
             iterations += 1;
             let cost = Self::wsse(&r, &w);
@@ -466,6 +491,7 @@ impl Problem<'_> {
                 0
             };
             if small >= 2 {
+                converged = true;
                 break;
             }
         }
@@ -477,6 +503,7 @@ impl Problem<'_> {
             cost,
             scale,
             iterations,
+            converged,
         }))
     }
 }
@@ -484,10 +511,11 @@ impl Problem<'_> {
 /// Fit the base parameters `names` of a model to a record from several starts.
 ///
 /// Every start is scored by its residual's sum of squares; the `scouts` best are
-/// followed `scout_iter` iterations, and the `keep` best of those to convergence, by
-/// Levenberg-Marquardt on the IGG-weighted residual (weights and scale renewed each
-/// iteration) and the one with the smallest loss at a common scale wins. The
-/// parameters not named keep each start's values.
+/// followed `scout_iter` iterations, and the `keep` best of those to convergence (a
+/// scout that converged as it went stays as it is), by Levenberg-Marquardt on the
+/// IGG-weighted residual (weights and scale renewed each iteration) and the one with
+/// the smallest loss at a common scale wins. The parameters not named keep each
+/// start's values.
 ///
 /// # Errors
 /// `mask` not of the record's length, no start, no parameter, an unknown name, or no
@@ -573,7 +601,9 @@ pub fn fit_base(
     };
     let mut runs: Vec<(usize, Run)> = Vec::new();
     for (_, k, scout) in rank(scouts).into_iter().take(opts.keep.max(1)) {
-        if let Some(mut run) = pb.run(&scout.model, opts.max_iter)? {
+        if scout.converged {
+            runs.push((k, scout));
+        } else if let Some(mut run) = pb.run(&scout.model, opts.max_iter)? {
             run.iterations += scout.iterations;
             runs.push((k, run));
         }
@@ -586,26 +616,18 @@ pub fn fit_base(
         )
     })?;
     let values: Vec<f64> = params.iter().map(|p| p.get(&best.model)).collect();
-    // information in the parameters themselves
-    let u = pb.encode(&best.model);
-    let j = pb.jacobian(&best.model, &u);
-    let jt: Vec<Vec<f64>> = j
-        .iter()
-        .zip(&u)
-        .zip(&pb.scales)
-        .map(|((c, ui), sc)| {
-            let d = pb.slope(*sc, *ui);
-            c.iter().map(|x| x / d).collect()
-        })
-        .collect();
-    let (a, _) = Problem::normal(&jt, &best.w, &best.r);
+    let information = if opts.information {
+        pb.information(&best)
+    } else {
+        Vec::new()
+    };
     Ok(BaseFit {
         values,
         cost: best.cost,
         scale: best.scale,
         criterion,
         weights: best.w.clone(),
-        information: a.transpose().as_slice().to_vec(),
+        information,
         start,
         iterations: best.iterations,
         evaluations: pb.evaluations,

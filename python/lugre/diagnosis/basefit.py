@@ -149,9 +149,14 @@ def starts(model: Model, sig: R.Signals) -> list[Model]:
 
 
 def _run(sig: R.Signals, start: list[Model], names: list[str], keep: int = 3,
-         max_iter: int = 60) -> tuple[Model, dict[str, Any]]:
+         max_iter: int = 60, tol: float = 1e-6, information: bool = True
+         ) -> tuple[Model, dict[str, Any]]:
+    """The kernel's fit from ``start``: the best model and the kernel's dict (its
+    ``information`` None unless asked; ``tol``: the relative fall of the weighted sum
+    of squares below which a start stops, twice in a row)."""
     out = sig.kernel.fit_base(start, [bool(b) for b in sig.mask], names,
-                              max_iter=max_iter, keep=keep, scouts=max(keep, SCOUTS))
+                              max_iter=max_iter, keep=keep, scouts=max(keep, SCOUTS),
+                              tol=tol, information=information)
     return apply_base(start[out["start"]], out["values"]), out
 
 
@@ -168,7 +173,8 @@ class Polisher:
     def __call__(self, model: Model, max_iter: int) -> tuple[float, Model, np.ndarray]:
         refused = math.inf, model, np.full(len(self.sig), np.inf)
         try:
-            best, _ = _run(self.sig, [model], self.names, keep=1, max_iter=max_iter)
+            best, _ = _run(self.sig, [model], self.names, keep=1, max_iter=max_iter,
+                           information=False)
             f = self.mass_factor
             if f is not None and not 1.0 / f < best.mass / model.mass < f:
                 return refused

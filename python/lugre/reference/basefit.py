@@ -153,7 +153,7 @@ class _Problem:
             return None
         doc, u = start, self.encode(start)
         w, scale = self.weights(r)
-        lam, iterations, small = 1e-3, 0, 0
+        lam, iterations, small, converged = 1e-3, 0, 0, False
         for _ in range(max_iter):
             iterations += 1
             cost = float(np.sum(w * r * r))
@@ -185,15 +185,27 @@ class _Problem:
             w, scale = self.weights(r)
             small = small + 1 if (rel < tol or moved < 1e-5) else 0
             if small >= 2:
+                converged = True
                 break
         return {"doc": doc, "r": r, "w": w, "scale": scale, "iterations": iterations,
-                "cost": float(np.sum(w * r * r))}
+                "cost": float(np.sum(w * r * r)), "converged": converged}
+
+
+def _information(pb: _Problem, run: dict[str, Any]) -> np.ndarray:
+    """``J^T W J`` of a run's model in the parameters themselves (not their logs)."""
+    u = pb.encode(run["doc"])
+    J = pb.jacobian(run["doc"], u)
+    J = J / np.array([pb.slope(sc, ui) for sc, ui in zip(pb.scales, u)])
+    return J.T @ (run["w"][:, None] * J)
 
 
 def fit_base(rec: Any, starts: list[Any], mask: Any, names: list[str], max_iter: int = 60,
              keep: int = 3, scouts: int = 12, weighting: str = "huber",
-             scout_iter: int = 6, tol: float = 1e-6) -> dict[str, Any]:
+             scout_iter: int = 6, tol: float = 1e-6, information: bool = True
+             ) -> dict[str, Any]:
     """Twin of ``_core.InverseRecord.fit_base`` (see ``lugre::inverse::fit_base``)."""
+    if not (math.isfinite(tol) and tol >= 0.0):
+        raise InputError.at("tol", f"must be a finite number >= 0, got {tol}")
     mask = np.asarray(mask, dtype=bool)
     if mask.size != len(rec):
         raise InputError.at("mask", f"has {mask.size} samples, the record {len(rec)}")
@@ -217,9 +229,10 @@ def fit_base(rec: Any, starts: list[Any], mask: Any, names: list[str], max_iter:
     found = [(k, pb.run(docs[k], scout_iter, tol)) for _, k in ranked[:max(scouts, keep, 1)]]
     runs = []
     for _, k, sc in rank([(k, r) for k, r in found if r is not None])[:max(keep, 1)]:
-        run = pb.run(sc["doc"], max_iter, tol)
+        run = sc if sc["converged"] else pb.run(sc["doc"], max_iter, tol)
         if run is not None:
-            run["iterations"] += sc["iterations"]
+            if run is not sc:
+                run["iterations"] += sc["iterations"]
             runs.append((k, run))
     best_all = rank(runs)
     if not best_all:
@@ -227,10 +240,7 @@ def fit_base(rec: Any, starts: list[Any], mask: Any, names: list[str], max_iter:
                         "recording's units and the force constant")
     criterion, start, best = best_all[0]
     doc = best["doc"]
-    u = pb.encode(doc)
-    J = pb.jacobian(doc, u)
-    J = J / np.array([pb.slope(sc, ui) for sc, ui in zip(pb.scales, u)])
-    info = J.T @ (best["w"][:, None] * J)
+    info = _information(pb, best) if information else None
     f = doc["friction"]
     values = {"mass": float(doc["axis"]["mass"])}
     for s in _SIDES:

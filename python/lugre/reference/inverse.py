@@ -468,7 +468,8 @@ class InverseRecord:
 
     def fit_base(self, starts: list[ModelLike], mask: Any, names: list[str],
                  max_iter: int = 60, keep: int = 3, scouts: int = 12,
-                 weighting: str = "huber") -> dict[str, Any]:
+                 weighting: str = "huber", tol: float = 1e-6,
+                 information: bool = True) -> dict[str, Any]:
         """The base parameters ``names`` fitted from ``starts`` (twin of the core's
         ``fit_base``; see ``lugre._reference_basefit``)."""
         import warnings
@@ -478,7 +479,8 @@ class InverseRecord:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             return fit_base(self, starts, mask, names, max_iter=max_iter, keep=keep,
-                            scouts=scouts, weighting=weighting)
+                            scouts=scouts, weighting=weighting, tol=tol,
+                            information=information)
 
     def base_sensitivities(self, model: ModelLike, names: list[str]
                            ) -> tuple[np.ndarray, np.ndarray, list[bool]]:
