@@ -78,7 +78,7 @@ class InverseRecord:
     def fit_base(
         self, starts: list[_ModelArg], mask: list[bool], names: list[str],
         max_iter: int = 60, keep: int = 3, scouts: int = 12,
-        weighting: str = "huber",
+        weighting: str = "huber", tol: float = 1e-6, information: bool = True,
     ) -> dict[str, Any]: ...
 
 _F64: TypeAlias = npt.NDArray[np.float64]
