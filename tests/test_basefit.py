@@ -145,26 +145,41 @@ def test_no_hump_is_reported_as_such():
         assert not res.profiles[f"{d}.vs"]["determined"]
 
 
-def test_core_and_twin_agree(records):
-    """The same fit from the same starts on the core's kernels and on the NumPy twin's."""
+def _on_core_and_twin(records, fit):
+    """``fit(sig, mask, start, names)`` on the first record's first 1.5 s, on the
+    core's kernels and on the NumPy twin's: both results and both kernels."""
     from lugre import reference
 
     rec = records[0].slice((0.0, 1.5))
     start = fit_inverse_dynamics(rec, force_constant=20.0, sliding=0.05)
     names = base_names(True)
-    out = {}
-    for be, kernels in (("core", "core"), ("reference", reference.kernels)):
+    out, kernels_used = [], []
+    for kernels in ("core", reference.kernels):
         sig = R.prepare(rec, start, backend=kernels)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            st = starts(start, sig)[:4]
-            out[be] = sig.kernel.fit_base(st, [bool(b) for b in sig.mask], names,
-                                          max_iter=15, keep=2, scouts=3)
-    assert isinstance(R.prepare(rec, start, backend=reference.kernels).kernel, reference.InverseRecord)
-    a, b = out["core"], out["reference"]
-    assert a["start"] == b["start"]
+            out.append(fit(sig, [bool(b) for b in sig.mask], start, names))
+        kernels_used.append(sig.kernel)
+    return out, kernels_used
+
+
+def _same_values(a, b):
     for k, v in a["values"].items():
         assert v == pytest.approx(b["values"][k], rel=1e-7, abs=1e-9), k
+
+
+def test_core_and_twin_agree(records):
+    """The same fit from the same starts on the core's kernels and on the NumPy twin's."""
+    from lugre import reference
+
+    def fit(sig, mask, start, names):
+        return sig.kernel.fit_base(starts(start, sig)[:4], mask, names, max_iter=15,
+                                   keep=2, scouts=3)
+
+    (a, b), (_, twin) = _on_core_and_twin(records, fit)
+    assert isinstance(twin, reference.InverseRecord)
+    assert a["start"] == b["start"]
+    _same_values(a, b)
     assert a["cost"] == pytest.approx(b["cost"], rel=1e-7)
 
 
@@ -172,31 +187,22 @@ def test_a_start_at_its_optimum_is_not_followed_again_and_the_twin_agrees(record
     """A scout that converged is kept as it is (two iterations from the optimum, not
     two more from where it stopped); a looser ``tol`` and no information give the same
     on the core and on the twin, the information None."""
-    from lugre import reference
 
-    rec = records[0].slice((0.0, 1.5))
-    start = fit_inverse_dynamics(rec, force_constant=20.0, sliding=0.05)
-    names = base_names(True)
-    out = {}
-    for be, kernels in (("core", "core"), ("reference", reference.kernels)):
-        sig = R.prepare(rec, start, backend=kernels)
-        mask = [bool(b) for b in sig.mask]
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            best = start
-            for _ in range(2):  # (this record's optimum is reached slowly)
-                first = sig.kernel.fit_base([best], mask, names, max_iter=300, keep=1)
-                best = apply_base(start, first["values"])
-            again = sig.kernel.fit_base([best], mask, names, keep=1, tol=1e-4,
-                                        information=False)
+    def fit(sig, mask, start, names):
+        best = start
+        for _ in range(2):  # (this record's optimum is reached slowly)
+            first = sig.kernel.fit_base([best], mask, names, max_iter=300, keep=1)
+            best = apply_base(start, first["values"])
         assert first["information"].shape == (len(names), len(names))
+        return sig.kernel.fit_base([best], mask, names, keep=1, tol=1e-4,
+                                   information=False)
+
+    (a, b), _ = _on_core_and_twin(records, fit)
+    for again in (a, b):
         assert again["information"] is None
         # (two iterations each under tol; followed again, two more)
-        assert again["iterations"] == 2, be
-        out[be] = again
-    a, b = out["core"], out["reference"]
-    for k, v in a["values"].items():
-        assert v == pytest.approx(b["values"][k], rel=1e-7, abs=1e-9), k
+        assert again["iterations"] == 2
+    _same_values(a, b)
 
 
 def test_fit_base_refuses_bad_arguments(records):
