@@ -86,3 +86,27 @@ def test_a_light_inertia_is_named_not_the_load_friction_it_looks_like():
     err = case["truth"]["axis"]["inertia"] - case["believed"]["axis"]["inertia"]
     assert d["findings"][0]["parameters"]["delta"] == pytest.approx(err, rel=0.2)
     assert [a["effect"] for a in d["findings"][0]["alternatives"]] == ["load_friction"]
+
+
+@pytest.mark.parametrize("seed", [39181, 39149, 38996, 39226])
+def test_a_term_that_stood_in_for_a_believed_base_is_dropped(seed):
+    """Clean records of the calibration bench whose believed base is off by 1-2 %:
+    39181 (a linear axis, constant-speed feeds, 5 s at 2 kHz) and 39149 (a joint,
+    point-to-point, 7 s at 1 kHz, coloured noise), where the search's linearised base
+    moves left a rest that a drag and a Stribeck shape took up on the confined route
+    (gains in 9 of 10 held-out blocks, p = 0.08 and 0.03); 38996 (PID, point-to-point,
+    3 s at 1 kHz) and 39226 (PI speed loop, feeds, 4 s at 500 Hz), where a spring and a
+    dead-band took up what a believed mass 1.7-2 % off left along the acceleration
+    (block t under 5). The base refitted without the term (and, for the weak ones, the
+    mass freed within 3 %) fits the record as well, and the search from there names
+    nothing."""
+    case = C.draw_case(seed, max_duration=15.0, min_duration=3.0)
+    (rec, hold), = C.records([(case, [])])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        kind = case["truth"]["axis"].get("kind", "linear")
+        dg = diagnose(Recording(**rec, meta={"axis_kind": kind}), Model(case["believed"]),
+                      holdout=Recording(**hold, meta={"axis_kind": kind}))
+    named = [f.effect for f in dg.findings if f.effect not in ("mass", "inertia")]
+    assert named == [], dg.findings
+    assert any("stood in for the base" in n for n in dg.notes), dg.notes
