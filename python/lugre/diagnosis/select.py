@@ -190,6 +190,8 @@ def _lookalikes(prep: Prepared, w: Weighing, bs: BaseSet, cands: list[E.Candidat
         eff, other = pending.pop(0)
         if eff in lookalike or other in lookalike or (eff, other) in done:
             continue
+        if not any(t.effect == eff and not t.minor for t in terms):
+            continue  # (a pair found before a swap whose chosen term the swap dropped)
         done.add((eff, other))
         terms_b, ev_b, log_b = run([c for c in cands if c.effect not in out | {eff}
                                     and c.effect not in refused])
