@@ -111,7 +111,7 @@ def _contribution(t: Term, beta: np.ndarray, ctx: E.Context, mask: np.ndarray) -
     secant's share: a clean record was named "a dead-band of 0 mA")."""
     c = t.cand
     if isinstance(c, _Secant) and np.size(beta) == 1:
-        return rms(c.columns(c.from_secant(t.h, float(beta[0])), ctx)[:, 0], mask)
+        return rms(c.columns(c.parameter(t.h, beta, ctx), ctx)[:, 0], mask)
     return rms(c.columns(t.h, ctx) @ beta, mask)
 
 

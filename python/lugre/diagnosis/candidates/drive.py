@@ -104,6 +104,25 @@ def _power(ctx: Context, x: np.ndarray, w: np.ndarray, k0: float, dk: float,
     return np.asarray(s) ** 2 + np.asarray(c) ** 2
 
 
+#: Coefficients on a current limit's secant read as the grid point's limit itself.
+NEAR_ONE = (0.8, 1.25)
+
+
+def _clip_of_excess(ia: np.ndarray, c: float, b: float) -> float:
+    """The limit [A] whose excess ``max(|i| - limit, 0)`` over the currents ``ia`` has
+    ``b`` times the rms of the excess over ``c`` (bisection: the rms falls as the limit
+    rises)."""
+    def excess(limit: float) -> float:
+        return float(np.sqrt(np.mean(np.maximum(ia - limit, 0.0) ** 2)))
+
+    want = b * excess(c)
+    lo, hi = (c, float(np.max(ia))) if b < 1.0 else (0.0, c)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if excess(mid) > want else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
 class CurrentLimit(_Secant):
     """``K_F*clip(i, -c, c)``: the record holds the command, the axis gets less above
     the limit. Searched over the percentiles of the recorded current (a saturated
@@ -149,8 +168,21 @@ class CurrentLimit(_Secant):
         # point's, found by the held-out profile (coarse, then fine)
         return float(h)
 
+    def parameter(self, h: Any, beta: np.ndarray, ctx: Context) -> Any:
+        """The limit whose clipped excess has the rms of ``beta`` times the excess at
+        ``h`` (the grid point's when ``beta`` is within :data:`NEAR_ONE` of 1): a clip at
+        1.42 A of a record whose peaks reach 5.4 A, taken at a coefficient of 0.06, is a
+        limit just under the peaks, not a drive clipped at 1.42 A (its exact form
+        ruined a coupling's story on a fitted base). A coefficient of zero or below
+        maps to the largest current: a limit that clips nothing."""
+        b, c = float(beta[0]), float(h)
+        if NEAR_ONE[0] <= b <= NEAR_ONE[1]:
+            return c
+        ia = np.abs(ctx.sig.fm[ctx.sig.mask]) / ctx.model.force_constant
+        return _clip_of_excess(ia, c, b)
+
     def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
-        c = self.from_secant(h, float(beta[0]))
+        c = self.parameter(h, beta, ctx)
         return (f"Above {amps(c)} ({c * ctx.model.force_constant:.3g} "
                 f"{U.si('N')}) the drive gives no more {U.force_words()}.")
 

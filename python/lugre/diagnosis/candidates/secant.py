@@ -68,11 +68,16 @@ class _Secant(Candidate):
         cols = self.columns_many(hs, ctx) or [self.columns(h, ctx) for h in hs]
         return [X[:, 0] for X in cols]
 
+    def parameter(self, h: Any, beta: np.ndarray, ctx: Context) -> Any:
+        """The parameter a coefficient ``beta`` on the secant at ``h`` stands for, on
+        this record (:meth:`from_secant` unless the record itself sets the map)."""
+        return self.from_secant(h, float(beta[0]))
+
     def to_effects(self, h: Any, beta: np.ndarray, ctx: Context) -> list[dict[str, Any]]:
-        return [self.effect_at(self.from_secant(h, float(beta[0])))]
+        return [self.effect_at(self.parameter(h, beta, ctx))]
 
     def recenter(self, h: Any, beta: np.ndarray, ctx: Context) -> tuple[Any, np.ndarray]:
-        return self.from_secant(h, float(beta[0])), np.ones(1)
+        return self.parameter(h, beta, ctx), np.ones(1)
 
     def uncertainty(self, term: Any, beta: np.ndarray, ctx: Context, sig: Signals,
                     s2: float) -> dict[str, Any]:
