@@ -48,3 +48,37 @@ def test_no_coefficient_or_a_negative_one_clips_nothing(b: float) -> None:
     assert c == pytest.approx(np.max(np.abs(I)), rel=1e-9)
     eff = D.CurrentLimit().to_effects(1.42, np.array([b]), _ctx(I))[0]
     assert eff == {"effect": "current_limit", "current": pytest.approx(c)}
+
+
+def test_a_limit_that_clips_only_the_very_peaks_is_refused_in_its_exact_form() -> None:
+    # a 3 A sine with ten short peaks at 5.4 A: a small coefficient on the clip at
+    # 1.42 A maps to a limit that clips those peaks alone (10 of 20 001 samples)
+    i = 3.0 * np.sin(np.linspace(0.0, 20.0 * np.pi, 20001))
+    i[1000::2000] = 5.4
+    b = np.array([0.02])
+    c = D.CurrentLimit().parameter(1.42, b, _ctx(i))
+    assert 3.0 < c < 5.4 and np.sum(np.abs(i) > c) == 10
+    why = D.CurrentLimit().exact_refusal(1.42, b, _ctx(i))
+    assert why is not None and "clips 10 of the record's 20001 samples" in why
+
+
+@pytest.mark.parametrize("b", [0.06, 0.9])
+def test_a_limit_that_clips_a_fair_share_stands(b: float) -> None:
+    c = D.CurrentLimit().parameter(1.42, np.array([b]), _ctx(I))
+    assert np.mean(np.abs(I) > c) > D.LEAST_CLIPPED
+    assert D.CurrentLimit().exact_refusal(1.42, np.array([b]), _ctx(I)) is None
+
+
+def test_the_interval_is_of_the_limits_the_profile_points_stand_for() -> None:
+    # every profile point's coefficient maps its grid point as the finding's limit is
+    # mapped: the interval holds the limit the finding reports
+    ctx = _ctx(I)
+    prof = {"h_obj": [1.2, 1.42, 1.7], "beta": [np.array([0.05]), np.array([0.06]),
+                                                np.array([0.08])],
+            "score": np.array([5.0, 0.0, 3.0])}
+    term = SimpleNamespace(profile=prof)
+    cl = D.CurrentLimit()
+    out = cl.uncertainty(term, np.array([0.06]), ctx, ctx.sig, 1.0)
+    c = cl.parameter(1.42, np.array([0.06]), ctx)
+    lo, hi = out["current"]
+    assert lo <= c <= hi and lo > 1.7

@@ -303,8 +303,15 @@ def refit(prep: Prepared, w: Weighing, sel: Selection, opts: Options) -> Joint:
 
 def _collapsed(rf: _Refitter, j: Joint) -> dict[int, str]:
     """Named terms that, in their exact form as the last refit left them, change the
-    force by nothing (a dead-band refitted to 0 mA once a resonance beside it went)."""
+    force by nothing (a dead-band refitted to 0 mA once a resonance beside it went) or
+    fail their own physics there (a current limit walked up to the very peaks)."""
     scale = rms(rf.sig.fm_f, rf.sig.mask)
-    return {k: "refitted with the rest, in its exact form it no longer changes the force"
-            for k, t in enumerate(j.terms) if not t.minor and not t.cand.timing
-            and _contribution(t, j.betas[k], j.ctx, rf.sig.mask) <= 1e-9 * scale}
+    out = {}
+    for k, t in enumerate(j.terms):
+        if t.minor or t.cand.timing:
+            continue
+        if _contribution(t, j.betas[k], j.ctx, rf.sig.mask) <= 1e-9 * scale:
+            out[k] = "refitted with the rest, in its exact form it no longer changes the force"
+        elif (why := t.cand.exact_refusal(t.h, j.betas[k], j.ctx)) is not None:
+            out[k] = "refitted with the rest, " + why
+    return out

@@ -186,6 +186,11 @@ class Candidate:
         """Why the term is not named, from :meth:`check`'s figures; None: it stands."""
         return None
 
+    def exact_refusal(self, h: Any, beta: np.ndarray, ctx: Context) -> str | None:
+        """Why the term, as the joint refit left it in its exact form (``h``, ``beta``),
+        is no finding of this physics; None: it stands (default)."""
+        return None
+
     def finding(self, term: Any, beta: np.ndarray, effect: dict[str, Any],
                 view: FindingView) -> Said:
         """What this effect adds to its finding beyond its parameters (default: nothing)."""

@@ -86,7 +86,7 @@ class _Secant(Candidate):
             return {}
         ok = pr["score"] <= pr["score"].min() + 10.0
         out: dict[str, Any] = {"criterion": "held-out score within 10 of the best"}
-        hs = [self.from_secant(h, float(b[0])) for h, b in zip(pr["h_obj"], pr["beta"])]
+        hs = [self.parameter(h, np.atleast_1d(b), ctx) for h, b in zip(pr["h_obj"], pr["beta"])]
         for name, vals in self.interval_params(hs, ok).items():
             out[name] = vals
         return out
