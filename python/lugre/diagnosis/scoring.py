@@ -31,8 +31,12 @@ from . import dsp
 from .candidates import Term
 from .candidates.base import rows_of
 
-__all__ = ["Evaluation", "Scorer", "accept", "accept_many", "block_evidence", "block_gains",
-           "compare", "rows_count", "rows_of", "told_apart"]
+__all__ = ["OVERWHELMING", "Evaluation", "Scorer", "accept", "accept_many",
+           "block_evidence", "block_gains", "compare", "rows_count", "rows_of",
+           "told_apart"]
+
+#: The confined route's gain, in multiples of ``min_gain``.
+OVERWHELMING = 20.0
 
 
 @dataclass
@@ -443,7 +447,7 @@ def told_apart(dd: np.ndarray, min_gain: float) -> tuple[bool, float]:
     sd = np.sign(dd.sum()) * dd
     lose = float(-sd[sd < 0].sum())
     apart = abs(dd.sum()) >= min_gain and (
-        tstat >= 3.0 or (abs(dd.sum()) > 20 * min_gain and int(np.sum(sd > 0)) >= 3
+        tstat >= 3.0 or (abs(dd.sum()) > OVERWHELMING * min_gain and int(np.sum(sd > 0)) >= 3
                          and float(sd[sd > 0].sum()) > 10 * lose))
     return bool(apart), float(tstat)
 
@@ -470,7 +474,7 @@ def accept(ev: dict[str, float], *, alpha: float, min_gain: float) -> tuple[bool
 
 def _overwhelming(gain: Any, positive: Any, ratio: Any, min_gain: float) -> Any:
     """:func:`accept`'s route for a confined mismatch (scalars or arrays alike)."""
-    return (gain > 20 * min_gain) & (positive >= 3) & (ratio > 10)
+    return (gain > OVERWHELMING * min_gain) & (positive >= 3) & (ratio > 10)
 
 
 def accept_many(d: np.ndarray, gain: np.ndarray, *, alpha: float,

@@ -101,7 +101,8 @@ def _refuse(w: Weighing, bs: BaseSet, cands: list[E.Candidate], opts: Options,
     while True:
         # (a refused effect is no longer a candidate: the terms never hold one)
         out = (_own_check(w, bs, checked, refused, terms, ev)
-               or partial_refusal(bs.scorer, terms, ev, log, w.noise["rms"]))
+               or partial_refusal(bs.scorer, terms, ev, log, w.noise["rms"],
+                                   opts.min_gain))
         if out is None:
             return terms, ev, log, refused
         effect, chk, why = out
