@@ -32,12 +32,6 @@ STAND_IN = 0.05
 #: margin it is weighed by (:data:`STAND_IN`).
 QUICK_TOL = 1e-4
 
-#: Largest break-away over Coulomb level of a refit taken as the record's base: a refit
-#: of a feed record with a friction bump and a Stribeck exponent of 0.9 put the
-#: negative direction's hump at 42 kN for a Coulomb level of 9 N (Stribeck speed 0.6
-#: mm/s), and the search from it named a coupling that doubled the held-out error.
-HUMP_RATIO = 10.0
-
 _TOL = dict(BASE_PARAMS)
 
 
@@ -83,8 +77,6 @@ def far_base(rec: Any, given: Model, augmented: Model, *, cutoff_hz: float | Non
     # effects pull it astray: a cogging on the slow samples doubles a hump), then put
     # into the given model, whose search runs again
     full = fit_base(sig, augmented, free_mass=free_mass, extra=[quick], profiles=False)
-    if _astray(full.model):
-        return None
     refit = apply_base(given, {n: get_base(full.model, n) for n, _ in BASE_PARAMS})
     moves = _moves(given, refit, names) or moved
     where = ("the base as given is far from what this record supports: "
@@ -98,12 +90,6 @@ def far_base(rec: Any, given: Model, augmented: Model, *, cutoff_hz: float | Non
             "in for a base parameter")
     return {"model": refit, "moves": moves, "rms_given": rms0, "rms_refit": rms1,
             "text": text}
-
-
-def _astray(model: Model) -> bool:
-    """A refit whose break-away is over :data:`HUMP_RATIO` times its Coulomb level in a
-    direction went astray: such a hump sits on the few samples nearest zero speed."""
-    return any(s["fs"] > HUMP_RATIO * s["fc"] for s in (model.positive, model.negative))
 
 
 def _moves(given: Model, refit: Model, names: list[str]) -> list[dict[str, Any]]:
