@@ -99,7 +99,7 @@ def test_a_term_that_stood_in_for_a_believed_base_is_dropped(seed):
     dead-band took up what a believed mass 1.7-2 % off left along the acceleration
     (block t under 5). The base refitted without the term (and, for the weak ones, the
     mass freed within 3 %) fits the record as well, and the search from there names
-    nothing."""
+    nothing, or the term is refused before (:data:`~lugre.diagnosis.partial.IN_RECORD`)."""
     case = C.draw_case(seed, max_duration=15.0, min_duration=3.0)
     (rec, hold), = C.records([(case, [])])
     with warnings.catch_warnings():
@@ -109,4 +109,7 @@ def test_a_term_that_stood_in_for_a_believed_base_is_dropped(seed):
                       holdout=Recording(**hold, meta={"axis_kind": kind}))
     named = [f.effect for f in dg.findings if f.effect not in ("mass", "inertia")]
     assert named == [], dg.findings
-    assert any("stood in for the base" in n for n in dg.notes), dg.notes
+    # (on 39149 no term is taken any more: the Stribeck shape's confined gain is refused
+    # as one the record fitted whole does not show)
+    taken = [t for t in dg.trials if t.get("accepted")]
+    assert not taken or any("stood in for the base" in n for n in dg.notes), dg.notes
