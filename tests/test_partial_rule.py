@@ -56,14 +56,14 @@ def test_a_term_that_explains_a_minor_part_on_the_confined_route_is_refused():
     ev = sc.evaluate([term])
     d = compare(sc.evaluate([]), ev, sc.s2)["d"]
     out = partial_refusal(sc, [term], ev, _log("stribeck_shape", d,
-                                                 "confined but overwhelming"), NOISE)
+                                                 "confined but overwhelming"), NOISE, 10.0)
     assert out is not None
     effect, figures, why = out
     assert effect == "stribeck_shape" and figures["share"] < PARTIAL_SHARE
     assert figures["share"] == pytest.approx(0.2, abs=0.05) and "only" in why
     # the same term taken on the consistent route is not this rule's to judge
     assert partial_refusal(sc, [term], ev, _log("stribeck_shape", d,
-                                                  "consistent over blocks"), NOISE) is None
+                                                  "consistent over blocks"), NOISE, 10.0) is None
 
 
 def test_a_term_that_explains_most_of_its_stretches_stands():
@@ -73,7 +73,7 @@ def test_a_term_that_explains_most_of_its_stretches_stands():
     ev = sc.evaluate([term])
     d = compare(sc.evaluate([]), ev, sc.s2)["d"]
     assert partial_refusal(sc, [term], ev, _log("position_friction", d,
-                                                  "confined but overwhelming"), NOISE) is None
+                                                  "confined but overwhelming"), NOISE, 10.0) is None
 
 
 def test_two_findings_that_explain_the_stretches_together_both_stand():
@@ -85,4 +85,4 @@ def test_two_findings_that_explain_the_stretches_together_both_stand():
     ev = sc.evaluate([ta, tb])
     d = compare(sc.evaluate([]), sc.evaluate([ta]), sc.s2)["d"]
     log = _log("offset", d, "confined but overwhelming")
-    assert partial_refusal(sc, [ta, tb], ev, log, NOISE) is None
+    assert partial_refusal(sc, [ta, tb], ev, log, NOISE, 10.0) is None

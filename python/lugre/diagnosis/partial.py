@@ -93,7 +93,8 @@ def partial_refusal(scorer: Scorer, terms: list[Any], ev: Evaluation,
             return t.effect, {"check": "partial", "share": share, "blocks": blocks}, why
         inside = in_record_gain(scorer, ev, g["d"])
         if inside < IN_RECORD * min_gain:
-            why = (f"it gains {g['gain']:.0f} on the {blocks} held-out blocks but "
+            held = float(g.get("gain", np.sum(g["d"])))
+            why = (f"it gains {held:.0f} on the {blocks} held-out blocks but "
                    f"{inside:.0f} in the record fitted whole (at least "
                    f"{IN_RECORD * min_gain:.0f} needed on the confined route): what it "
                    "mends is the base predicting a stretch it was not fitted on (one that "
