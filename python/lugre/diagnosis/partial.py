@@ -14,6 +14,12 @@ but for a delay beside a base 8 % off, which took 33 % and is no longer named.
 So, with every finding in, the held-out error beyond the noise in the blocks where the
 term gained must be at most ``1 - PARTIAL_SHARE`` of the base's there; otherwise the term
 is not named, and what is left is the unexplained check's to describe.
+
+A held-out block can also be one the base mispredicts because it alone holds part of
+the motion (the only slow feeds of a record at its end): a term that mends that gains
+held out and nothing in the record fitted whole. So the findings must also gain at least
+``IN_RECORD`` times the acceptance's ``min_gain`` in those blocks with the base and them
+fitted on every block.
 """
 
 from __future__ import annotations
