@@ -47,22 +47,24 @@ CONFINED = "confined but overwhelming"
 
 
 def explained_share(scorer: Scorer, ev: Evaluation, gains: np.ndarray,
-                    noise_rms: float) -> float:
+                    noise_rms: float, base: Evaluation | None = None) -> float:
     """Share of the base's held-out error beyond the noise, in the blocks where
-    ``gains`` (per-block score gains) are positive, that ``ev`` removes."""
+    ``gains`` (per-block score gains) are positive, that ``ev`` removes (``base``: the
+    scorer's fit without terms, when the caller has it)."""
     pos = np.asarray(gains) > 0
-    base = scorer.evaluate([])
+    base = scorer.evaluate([]) if base is None else base
     floor = noise_rms ** 2 * scorer.block_samples  # noise alone, in one block [N^2]
     before = float(np.maximum(base.sse_b[pos] - floor, 0.0).sum())
     after = float(np.maximum(ev.sse_b[pos] - floor, 0.0).sum())
     return 1.0 - after / before if before > 0 else 1.0
 
 
-def in_record_gain(scorer: Scorer, ev: Evaluation, gains: np.ndarray) -> float:
+def in_record_gain(scorer: Scorer, ev: Evaluation, gains: np.ndarray,
+                   base: Evaluation | None = None) -> float:
     """What the findings ``ev`` gain in the record itself, the base and they fitted on
     every block, in the blocks where ``gains`` (per-block held-out gains) are positive
     [noise units]."""
-    base = scorer.evaluate([])
+    base = scorer.evaluate([]) if base is None else base
     r0, r1 = base.resid, ev.resid
     rows = [scorer.idx[scorer.blocks[k]] for k in np.flatnonzero(np.asarray(gains) > 0)]
     sse = sum(float(np.sum(r0[i] ** 2) - np.sum(r1[i] ** 2)) for i in rows)
@@ -83,6 +85,7 @@ def partial_refusal(scorer: Scorer, terms: list[Any], ev: Evaluation,
     """The first named term taken on the confined route whose blocks keep most of their
     mismatch with every finding in, or whose findings gain little there in the record
     itself: ``(effect, figures, why)``; None when there is none."""
+    base = None
     for t in terms:
         if t.minor:
             continue
@@ -90,14 +93,15 @@ def partial_refusal(scorer: Scorer, terms: list[Any], ev: Evaluation,
         if g is None:
             continue
         blocks = int(np.sum(np.asarray(g["d"]) > 0))
-        share = explained_share(scorer, ev, g["d"], noise_rms)
+        base = scorer.evaluate([]) if base is None else base
+        share = explained_share(scorer, ev, g["d"], noise_rms, base)
         if share < PARTIAL_SHARE:
             why = (f"the findings remove only {100 * share:.0f} % of the mismatch beyond "
                    f"the noise in the {blocks} held-out blocks where it gains (at least "
                    f"{100 * PARTIAL_SHARE:.0f} % needed on the confined route): it "
                    "explains a part of something else")
             return t.effect, {"check": "partial", "share": share, "blocks": blocks}, why
-        inside = in_record_gain(scorer, ev, g["d"])
+        inside = in_record_gain(scorer, ev, g["d"], base)
         if inside < IN_RECORD * min_gain:
             held = float(g.get("gain", np.sum(g["d"])))
             why = (f"it gains {held:.0f} on the {blocks} held-out blocks but "

@@ -16,7 +16,7 @@ from ..residual import Signals, position_sums
 from .base import Candidate, Context, by, by_current
 from .linear import mass_both_ways
 from .position import Cogging, by_pitch, periodic_sizes, pitch_bands
-from .probe import amps, hide, share, two_ways, under
+from .probe import amps, currents, hide, share, two_ways, under
 from .secant import _Secant
 
 __all__ = ["BRAKING_SHARE", "CurrentLimit", "ForceRipple", "LoadFriction"]
@@ -117,18 +117,6 @@ NEAR_ONE = (0.8, 1.25)
 LEAST_CLIPPED = 0.002
 
 
-def _clipped(limit: float, ctx: Context) -> dict[str, Any]:
-    """A current limit [A] and how many of the record's samples in motion it clips."""
-    ia = np.abs(ctx.sig.fm[ctx.sig.mask]) / ctx.model.force_constant
-    return {"current": float(limit), "clipped": int(np.sum(ia > limit)), "samples": ia.size}
-
-
-def _too_few_clipped(chk: dict[str, Any]) -> str:
-    return (f"a limit at {amps(chk['current'])} clips {chk['clipped']} of the record's "
-            f"{chk['samples']} samples in motion: a clip of the very peaks is what a lag, "
-            "a resonance or a mass error leaves there too")
-
-
 def _clip_of_excess(ia: np.ndarray, c: float, b: float) -> float:
     """The limit [A] whose excess ``max(|i| - limit, 0)`` over the currents ``ia`` has
     ``b`` times the rms of the excess over ``c`` (bisection: the rms falls as the limit
@@ -163,7 +151,7 @@ class CurrentLimit(_Secant):
                  "asks for more than acts at the peaks of the current")
 
     def grid(self, ctx: Context) -> np.ndarray | None:
-        ia = np.abs(ctx.sig.fm[ctx.sig.mask]) / ctx.model.force_constant
+        ia = currents(ctx)
         if ia.size == 0 or not float(np.max(ia)) > 0:
             return None
         return np.percentile(ia, [20.0, 35.0, 50.0, 65.0, 75.0, 85.0, 92.0, 96.0, 98.5, 99.5])
@@ -187,10 +175,14 @@ class CurrentLimit(_Secant):
     def exact_refusal(self, h: Any, beta: np.ndarray, ctx: Context) -> str | None:
         # (refitted with the base, a coefficient under one maps the limit higher each
         # pass: a misfit of the peaks walks it up to the record's largest current)
-        chk = _clipped(self.parameter(h, beta, ctx), ctx)
-        if chk["clipped"] >= LEAST_CLIPPED * chk["samples"]:
+        c = self.parameter(h, beta, ctx)
+        ia = currents(ctx)
+        clipped = int(np.sum(ia > c))
+        if clipped >= LEAST_CLIPPED * ia.size:
             return None
-        return _too_few_clipped(chk)
+        return (f"a limit at {amps(c)} clips {clipped} of the record's {ia.size} samples "
+                "in motion: a clip of the very peaks is what a lag, a resonance or a mass "
+                "error leaves there too")
 
     def from_secant(self, h: Any, b: float) -> Any:
         # the clipped excess is far from linear in the limit: the limit is the grid
@@ -207,7 +199,7 @@ class CurrentLimit(_Secant):
         b, c = float(beta[0]), float(h)
         if NEAR_ONE[0] <= b <= NEAR_ONE[1]:
             return c
-        ia = np.abs(ctx.sig.fm[ctx.sig.mask]) / ctx.model.force_constant
+        ia = currents(ctx)
         return _clip_of_excess(ia, c, b)
 
     def describe(self, h: Any, beta: np.ndarray, ctx: Context) -> str:
@@ -218,7 +210,7 @@ class CurrentLimit(_Secant):
     figure = by_current
 
     def limit(self, ctx: Context, sizes: Any) -> dict[str, Any] | None:
-        ia = np.abs(ctx.sig.fm[ctx.sig.mask]) / ctx.model.force_constant
+        ia = currents(ctx)
         top = float(np.max(ia)) if ia.size else 0.0
         return hide(self.effect, math.inf, "A",
                     f"a current limit above {amps(top)} (the largest current of this "

@@ -11,7 +11,7 @@ import numpy as np
 from ... import units as U
 from .. import residual as R
 
-__all__ = ["AT_ONCE", "amps", "hide", "in_batches", "rate_noise_power", "refit_on",
+__all__ = ["AT_ONCE", "amps", "currents", "hide", "in_batches", "rate_noise_power", "refit_on",
            "reversals", "share", "start_of", "two_ways", "under"]
 
 
@@ -112,6 +112,11 @@ def hide(effect: str, b: float, unit: str, what: str, rng: Any = None,
     return {"effect": effect, "smallest": b if np.isfinite(b) else None, "unit": U.si(unit),
             "range": rng, "experiment": U.words(experiment),
             "text": U.words(f"{what} {verb} this record")}
+
+
+def currents(ctx: Any) -> np.ndarray:
+    """The magnitude of the logged current [A] on the samples in motion."""
+    return np.abs(ctx.sig.fm[ctx.sig.mask]) / ctx.model.force_constant
 
 
 def amps(a: float) -> str:

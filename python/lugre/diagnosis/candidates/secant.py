@@ -13,7 +13,7 @@ from ...vocabulary import DEADBAND, STRIBECK_SHAPE, is_timing
 from .. import residual as R
 from ..residual import Signals
 from .base import Candidate, Context, by, by_current, grid_interval
-from .probe import AT_ONCE, amps, hide, refit_on, start_of
+from .probe import AT_ONCE, amps, currents, hide, refit_on, start_of
 
 __all__ = ["Deadband", "StribeckShape", "_Secant"]
 
@@ -175,7 +175,7 @@ class Deadband(_Secant):
                  "force lags the command at every change of the current's sign")
 
     def grid(self, ctx: Context) -> np.ndarray | None:
-        ia = np.abs(ctx.sig.fm[ctx.sig.mask]) / ctx.model.force_constant
+        ia = currents(ctx)
         top = float(np.percentile(ia, 50))
         if not top > 0:
             return None
